@@ -1,0 +1,92 @@
+//! What every filter's `main` shares: the program name in messages, exit statuses, the common
+//! input/output/report arguments, warnings, and progress bars that appear only on a terminal.
+
+use crate::error::Result;
+use std::io::IsTerminal;
+use std::path::PathBuf;
+use std::process::ExitCode;
+use std::sync::OnceLock;
+
+static PROGRAM: OnceLock<&'static str> = OnceLock::new();
+
+/// The running filter's name, for messages.
+pub fn program() -> &'static str {
+    PROGRAM.get().copied().unwrap_or("camkit")
+}
+
+/// Runs a filter's body: errors become one line on stderr (`name: file:line:col (field): what`)
+/// and the exit status of their kind; a closed output pipe ends quietly with status 0; a panic
+/// (a bug) prints one line, not a backtrace.
+pub fn run(name: &'static str, body: impl FnOnce() -> Result<()>) -> ExitCode {
+    let _ = PROGRAM.set(name);
+    std::panic::set_hook(Box::new(|info| {
+        let place = info.location().map(|l| format!(" at {}:{}", l.file(), l.line())).unwrap_or_default();
+        let what = info
+            .payload()
+            .downcast_ref::<&str>()
+            .map(|s| s.to_string())
+            .or_else(|| info.payload().downcast_ref::<String>().cloned())
+            .unwrap_or_else(|| "panic".into());
+        eprintln!("{}: internal error (a bug, please report it): {what}{place}", program());
+    }));
+    match body() {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            if e.kind != crate::error::ErrorKind::BrokenPipe {
+                eprintln!("{name}: {e}");
+            }
+            ExitCode::from(e.exit_status() as u8)
+        }
+    }
+}
+
+/// Prints a warning on stderr (`name: warning: ...`).
+pub fn warn(message: &str) {
+    eprintln!("{}: warning: {message}", program());
+}
+
+/// Arguments every filter takes: input, `-o`, `--report`.
+#[derive(Clone, Debug, clap::Args)]
+pub struct IoArgs {
+    /// Input file; `-` or nothing reads standard input.
+    #[arg(default_value = "-", value_name = "INPUT")]
+    pub input: String,
+    /// Write the output to FILE (whole or not at all) instead of standard output.
+    #[arg(short = 'o', long = "output", value_name = "FILE")]
+    pub output: Option<PathBuf>,
+    /// Write figures of the run (counts, deviations, timings) to FILE as JSON.
+    #[arg(long, value_name = "FILE")]
+    pub report: Option<PathBuf>,
+}
+
+/// A progress bar on stderr when stderr is a terminal; silent in pipes and tests.
+pub struct Progress {
+    bar: indicatif::ProgressBar,
+}
+
+impl Progress {
+    /// A bar for `total` steps of `what`.
+    pub fn new(total: u64, what: &str) -> Progress {
+        let bar = if std::io::stderr().is_terminal() {
+            let bar = indicatif::ProgressBar::new(total);
+            let style = indicatif::ProgressStyle::with_template("{msg} [{bar:40}] {pos}/{len} ({eta})")
+                .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar());
+            bar.set_style(style.progress_chars("=> "));
+            bar.set_message(what.to_string());
+            bar
+        } else {
+            indicatif::ProgressBar::hidden()
+        };
+        Progress { bar }
+    }
+
+    /// Advances by `n` steps.
+    pub fn inc(&self, n: u64) {
+        self.bar.inc(n);
+    }
+
+    /// Removes the bar.
+    pub fn finish(&self) {
+        self.bar.finish_and_clear();
+    }
+}

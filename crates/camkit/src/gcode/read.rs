@@ -1,0 +1,548 @@
+//! The G-code reader: one pass over the bytes, words parsed to exact decimals, modal state
+//! tracked, every line kept as a block.
+
+use super::{Block, Modes, Motion, MoveBlock, OtherBlock, Program, Units};
+use crate::error::{Error, Location, Result};
+use crate::geom::{P2, P3, Plane, V2};
+
+/// Most decimals seen in the program's words, per kind.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Decimals {
+    /// X, Y, Z, I, J, K, R.
+    pub xyz: u32,
+    /// E.
+    pub e: u32,
+}
+
+/// One word of a block: letter, value, where it sits in the line.
+#[derive(Clone, Copy, Debug)]
+struct Word {
+    letter: u8,
+    value: f64,
+    decimals: u32,
+    start: usize,
+    end: usize,
+}
+
+/// Exact powers of ten.
+const POW10: [f64; 23] = [
+    1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11, 1e12, 1e13, 1e14, 1e15, 1e16, 1e17, 1e18, 1e19, 1e20,
+    1e21, 1e22,
+];
+
+/// Parses a G-code number at `line[i..]`: optional sign, digits, at most one point. Returns the
+/// value (correctly rounded), the index after it and its number of decimals.
+fn parse_number(line: &[u8], mut i: usize) -> Option<(f64, usize, u32)> {
+    let start = i;
+    let neg = match line.get(i) {
+        Some(b'-') => {
+            i += 1;
+            true
+        }
+        Some(b'+') => {
+            i += 1;
+            false
+        }
+        _ => false,
+    };
+    // `frac` counts decimals kept in the mantissa, `decimals` all digits after the point.
+    let (mut mantissa, mut digits, mut frac, mut decimals, mut dot) = (0u64, 0u32, 0u32, 0u32, false);
+    while let Some(&c) = line.get(i) {
+        if c.is_ascii_digit() {
+            if digits < 19 {
+                mantissa = mantissa * 10 + u64::from(c - b'0');
+                if dot {
+                    frac += 1;
+                }
+            }
+            digits += 1;
+            if dot {
+                decimals += 1;
+            }
+        } else if c == b'.' && !dot {
+            dot = true;
+        } else {
+            break;
+        }
+        i += 1;
+    }
+    if digits == 0 {
+        return None;
+    }
+    let value = if digits <= 19 && mantissa < (1u64 << 53) && (frac as usize) < POW10.len() {
+        mantissa as f64 / POW10[frac as usize]
+    } else {
+        std::str::from_utf8(&line[start..i]).ok()?.parse::<f64>().ok()?.abs()
+    };
+    Some((if neg { -value } else { value }, i, decimals))
+}
+
+/// Reads a whole program. `name` is used in error messages.
+pub fn read(name: &str, source: String) -> Result<Program> {
+    let mut reader = Reader {
+        name,
+        modes: Modes::default(),
+        pos: [0.0; 3],
+        known: [false; 3],
+        virtual_frame: false,
+        e_mode_relative: false,
+    };
+    let mut blocks = Vec::with_capacity(source.len() / 24 + 1);
+    let mut decimals = Decimals::default();
+    let mut words: Vec<Word> = Vec::with_capacity(16);
+    let bytes = source.as_bytes();
+    let mut line_start = 0usize;
+    let mut line_no = 0u32;
+    while line_start < bytes.len() {
+        line_no += 1;
+        let nl = memchr::memchr(b'\n', &bytes[line_start..]).map_or(bytes.len(), |k| line_start + k);
+        let mut line_end = nl;
+        if line_end > line_start && bytes[line_end - 1] == b'\r' {
+            line_end -= 1;
+        }
+        let span = line_start..line_end;
+        let block = reader.block(&bytes[span.clone()], span, line_no, &mut words, &mut decimals)?;
+        blocks.push(block);
+        line_start = nl + 1;
+    }
+    Ok(Program { source, blocks, decimals })
+}
+
+struct Reader<'a> {
+    name: &'a str,
+    modes: Modes,
+    /// Current position (mm).
+    pos: [f64; 3],
+    /// Which coordinates of `pos` are known.
+    known: [bool; 3],
+    /// `pos` was made up (a G91 program starting at an unknown place): relative geometry only.
+    virtual_frame: bool,
+    /// M83 in effect.
+    e_mode_relative: bool,
+}
+
+/// What the G words of a block ask for, beyond modal settings.
+#[derive(Default)]
+struct GEffects {
+    motion: Option<Motion>,
+    /// G codes other than the motion word: the block cannot be replaced.
+    extra_g: bool,
+    /// A G code that moves the machine or shifts coordinates in a way not modelled.
+    moves_unmodelled: bool,
+    /// G92 (coordinate shift); harmless for positions when it only names E.
+    g92: bool,
+}
+
+impl Reader<'_> {
+    fn err(&self, line: u32, col: usize, word: &[u8], message: &str) -> Error {
+        let word = String::from_utf8_lossy(word).into_owned();
+        Error::input(message).at(Location::file(self.name).line(u64::from(line)).column(col as u64 + 1).field(word))
+    }
+
+    /// Splits a line into words; `Ok(true)` if it had a comment or checksum.
+    fn words(&self, line: &[u8], line_no: u32, words: &mut Vec<Word>) -> Result<bool> {
+        words.clear();
+        let mut remark = false;
+        let mut i = 0;
+        while i < line.len() {
+            let c = line[i];
+            match c {
+                b' ' | b'\t' => i += 1,
+                b'(' => {
+                    remark = true;
+                    match memchr::memchr(b')', &line[i..]) {
+                        Some(k) => i += k + 1,
+                        None => return Err(self.err(line_no, i, &line[i..], "comment is not closed with `)`")),
+                    }
+                }
+                b';' | b'*' => return Ok(true),
+                _ if c.is_ascii_alphabetic() => {
+                    let letter = c.to_ascii_uppercase();
+                    let mut j = i + 1;
+                    while j < line.len() && (line[j] == b' ' || line[j] == b'\t') {
+                        j += 1;
+                    }
+                    let word_end = |from: usize| {
+                        from + line[from..]
+                            .iter()
+                            .position(|b| b.is_ascii_whitespace() || *b == b'(' || *b == b';')
+                            .unwrap_or(line.len() - from)
+                    };
+                    if matches!(line.get(j), Some(b'#' | b'[')) {
+                        return Err(self.err(
+                            line_no,
+                            i,
+                            &line[i..word_end(j)],
+                            "parameters and expressions are not supported",
+                        ));
+                    }
+                    let Some((value, end, decimals)) = parse_number(line, j) else {
+                        return Err(self.err(
+                            line_no,
+                            i,
+                            &line[i..word_end(j)],
+                            "malformed word: a letter must be followed by a number",
+                        ));
+                    };
+                    if let Some(&next) = line.get(end)
+                        && !(next.is_ascii_alphabetic() || matches!(next, b' ' | b'\t' | b'(' | b';' | b'*'))
+                    {
+                        return Err(self.err(line_no, i, &line[i..word_end(end)], "malformed word"));
+                    }
+                    if letter == b'O' {
+                        return Err(self.err(
+                            line_no,
+                            i,
+                            &line[i..end],
+                            "o-codes (subroutines, loops) are not supported",
+                        ));
+                    }
+                    if !matches!(letter, b'G' | b'M') && words.iter().any(|w| w.letter == letter) {
+                        return Err(self.err(line_no, i, &line[i..end], "word appears twice in one block"));
+                    }
+                    words.push(Word { letter, value, decimals, start: i, end });
+                    i = end;
+                }
+                _ => {
+                    let end = i + line[i..].iter().position(|b| b.is_ascii_whitespace()).unwrap_or(line.len() - i);
+                    return Err(self.err(line_no, i, &line[i..end], "unknown word"));
+                }
+            }
+        }
+        Ok(remark)
+    }
+
+    /// Applies the modal G and M words of a block; returns what else they ask for.
+    fn apply_modal(&mut self, words: &[Word], line: &[u8], line_no: u32) -> Result<GEffects> {
+        let mut fx = GEffects::default();
+        for w in words {
+            let code = (w.value * 10.0).round() as i64;
+            match w.letter {
+                b'G' => {
+                    match code {
+                        0 | 10 | 20 | 30 => {
+                            if fx.motion.is_some() {
+                                return Err(self.err(
+                                    line_no,
+                                    w.start,
+                                    &line[w.start..w.end],
+                                    "two motion codes in one block",
+                                ));
+                            }
+                            fx.motion = Some(match code {
+                                0 => Motion::Rapid,
+                                10 => Motion::Line,
+                                20 => Motion::Cw,
+                                _ => Motion::Ccw,
+                            });
+                            continue;
+                        }
+                        170 => self.modes.plane = Plane::Xy,
+                        180 => self.modes.plane = Plane::Xz,
+                        190 => self.modes.plane = Plane::Yz,
+                        200 => self.modes.units = Units::Inch,
+                        210 => self.modes.units = Units::Mm,
+                        900 => {
+                            self.modes.relative = false;
+                            if self.virtual_frame {
+                                self.known = [false; 3];
+                                self.virtual_frame = false;
+                            }
+                        }
+                        910 => self.modes.relative = true,
+                        901 => self.modes.absolute_arc_centres = true,
+                        911 => self.modes.absolute_arc_centres = false,
+                        930 => self.modes.inverse_time = true,
+                        940 => self.modes.inverse_time = false,
+                        800 => self.modes.motion = None,
+                        // Modal settings and dwell that do not move the machine.
+                        40
+                        | 400
+                        | 490
+                        | 500
+                        | 610
+                        | 611
+                        | 640
+                        | 641
+                        | 950
+                        | 960
+                        | 970
+                        | 990
+                        | 980
+                        | 150
+                        | 160
+                        | 540..=599 => {}
+                        920 => fx.g92 = true,
+                        _ => fx.moves_unmodelled = true,
+                    }
+                    fx.extra_g = true;
+                }
+                b'M' => match code {
+                    820 => self.e_mode_relative = false,
+                    830 => self.e_mode_relative = true,
+                    _ => {}
+                },
+                _ => {}
+            }
+        }
+        self.modes.e_relative = self.e_mode_relative || self.modes.relative;
+        Ok(fx)
+    }
+
+    fn block(
+        &mut self,
+        line: &[u8],
+        span: std::ops::Range<usize>,
+        line_no: u32,
+        words: &mut Vec<Word>,
+        decimals: &mut Decimals,
+    ) -> Result<Block> {
+        let first = line.iter().position(|b| !b.is_ascii_whitespace());
+        // Blank lines, block delete and tape marks are not interpreted.
+        if first.is_none_or(|i| matches!(line[i], b'/' | b'%')) {
+            return Ok(Block::Other(OtherBlock { line: line_no, span, modes: self.modes, motion_word: false }));
+        }
+        let remark = self.words(line, line_no, words)?;
+        let fx = self.apply_modal(words, line, line_no)?;
+        let motion_word =
+            fx.motion.is_some() || words.iter().any(|w| w.letter == b'G' && (w.value * 10.0).round() as i64 == 800);
+        let other = |span, modes| Ok(Block::Other(OtherBlock { line: line_no, span, modes, motion_word }));
+        if words.is_empty() {
+            return other(span, self.modes);
+        }
+        let scale = self.modes.units.mm();
+        let (mut axes, mut ijk) = ([None; 3], [None; 3]);
+        let (mut r, mut f, mut e, mut n, mut p) = (None, None, None, None, None);
+        let mut unmodelled_word = false;
+        for w in words.iter() {
+            match w.letter {
+                b'X' | b'Y' | b'Z' => {
+                    axes[usize::from(w.letter - b'X')] = Some(w.value * scale);
+                    decimals.xyz = decimals.xyz.max(w.decimals);
+                }
+                b'I' | b'J' | b'K' => {
+                    ijk[usize::from(w.letter - b'I')] = Some(w.value * scale);
+                    decimals.xyz = decimals.xyz.max(w.decimals);
+                }
+                b'R' => r = Some((w.value * scale, w)),
+                b'F' => f = Some(w.value),
+                b'E' => {
+                    e = Some(w.value);
+                    decimals.e = decimals.e.max(w.decimals);
+                }
+                b'N' => n = Some(w.value as u64),
+                b'P' => p = Some(w.value),
+                b'G' | b'M' => {}
+                _ => unmodelled_word = true,
+            }
+        }
+        if let Some(fv) = f {
+            if fv <= 0.0 && !self.modes.inverse_time {
+                let w = words.iter().find(|w| w.letter == b'F').expect("F word present");
+                return Err(self.err(line_no, w.start, &line[w.start..w.end], "feed must be positive"));
+            }
+            self.modes.feed = Some(if self.modes.inverse_time { fv } else { fv * scale });
+        }
+        if let Some(m) = fx.motion {
+            self.modes.motion = Some(m);
+        }
+        let has_axes = axes.iter().any(Option::is_some);
+        let g92_only_e = fx.g92 && !has_axes;
+        if fx.moves_unmodelled || (fx.g92 && !g92_only_e) {
+            // G28, G53, G92 with axes, G43, canned cycles...: where the machine is afterwards is not known.
+            self.known = [false; 3];
+            return other(span, self.modes);
+        }
+        let motion = match self.modes.motion {
+            Some(m)
+                if has_axes
+                    || (m.is_arc() && fx.motion.is_some() && (ijk.iter().any(Option::is_some) || r.is_some())) =>
+            {
+                m
+            }
+            _ => {
+                if has_axes {
+                    return Err(self.err(line_no, 0, line, "coordinates without a motion mode (G0, G1, G2 or G3)"));
+                }
+                return other(span, self.modes);
+            }
+        };
+        if self.modes.relative && self.known.iter().any(|k| !k) {
+            // A G91 program that starts at an unknown place: measure from a made-up origin.
+            for k in 0..3 {
+                if !self.known[k] {
+                    self.pos[k] = 0.0;
+                    self.known[k] = true;
+                }
+            }
+            self.virtual_frame = true;
+        }
+        let start_known = self.known.iter().all(|&k| k);
+        let start = P3::from(self.pos);
+        let mut end = self.pos;
+        for k in 0..3 {
+            if let Some(v) = axes[k] {
+                end[k] = if self.modes.relative { self.pos[k] + v } else { v };
+                self.known[k] = true;
+            }
+        }
+        let end = P3::from(end);
+        let plane = self.modes.plane;
+        let centre = if motion.is_arc() {
+            Some(self.arc_centre(&start, &end, plane, ijk, r, motion, line, line_no)?)
+        } else {
+            None
+        };
+        let turns = match p {
+            Some(v) if motion.is_arc() && v >= 1.0 => v as u32 - 1,
+            _ => 0,
+        };
+        self.pos = [end.x, end.y, end.z];
+        let plain = !remark && !fx.extra_g && !unmodelled_word && p.is_none() && !self.modes.inverse_time;
+        Ok(Block::Move(MoveBlock {
+            line: line_no,
+            span,
+            motion,
+            explicit: fx.motion.is_some(),
+            start,
+            start_known,
+            end,
+            centre,
+            turns,
+            modes: self.modes,
+            has_f: f.is_some(),
+            e,
+            n,
+            plain,
+        }))
+    }
+
+    /// The centre of an arc block in plane coordinates, from I/J/K or R.
+    #[allow(clippy::too_many_arguments)]
+    fn arc_centre(
+        &self,
+        start: &P3,
+        end: &P3,
+        plane: Plane,
+        ijk: [Option<f64>; 3],
+        r: Option<(f64, &Word)>,
+        motion: Motion,
+        line: &[u8],
+        line_no: u32,
+    ) -> Result<P2> {
+        let (s, _) = plane.split(start);
+        let (e, _) = plane.split(end);
+        let [u, v, _] = plane.axes();
+        if let Some((radius, w)) = r {
+            let chord = e - s;
+            let half = 0.5 * chord.norm();
+            let h2 = radius * radius - half * half;
+            let slack = 1e-9 * radius.abs().max(1.0);
+            if half == 0.0 || h2 < -slack {
+                return Err(self.err(
+                    line_no,
+                    w.start,
+                    &line[w.start..w.end],
+                    "arc radius is smaller than half the distance between its ends",
+                ));
+            }
+            let h = h2.max(0.0).sqrt();
+            let left = V2::new(-chord.y, chord.x) / (2.0 * half);
+            // G3 with R > 0 turns left of the chord about a centre on the left; G2 on the right;
+            // a negative R asks for the arc over 180° and puts the centre on the other side.
+            let side = if (motion == Motion::Ccw) == (radius > 0.0) { 1.0 } else { -1.0 };
+            return Ok(P2::from((s.coords + e.coords) * 0.5) + left * (side * h));
+        }
+        let off = |axis: usize| ijk[axis].unwrap_or(0.0);
+        Ok(if self.modes.absolute_arc_centres { P2::new(off(u), off(v)) } else { P2::new(s.x + off(u), s.y + off(v)) })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn parse(text: &str) -> Result<Program> {
+        read("t.nc", text.to_string())
+    }
+
+    fn moves(p: &Program) -> Vec<&MoveBlock> {
+        p.blocks.iter().filter_map(|b| if let Block::Move(m) = b { Some(m) } else { None }).collect()
+    }
+
+    #[test]
+    fn numbers_are_exact_decimals() {
+        assert_eq!(parse_number(b"43.9090", 0), Some((43.909, 7, 4)));
+        assert_eq!(parse_number(b"-.5", 0), Some((-0.5, 3, 1)));
+        assert_eq!(parse_number(b"10.", 0), Some((10.0, 3, 0)));
+        assert_eq!(parse_number(b"+7", 0), Some((7.0, 2, 0)));
+        assert_eq!(parse_number(b"x", 0), None);
+        assert_eq!(parse_number(b"0.1", 0).unwrap().0, "0.1".parse::<f64>().unwrap());
+        assert_eq!(parse_number(b"75.04942656", 0).unwrap().0, 75.04942656);
+    }
+
+    #[test]
+    fn modal_moves_units_and_numbers() {
+        let p = parse("G20 G90\nN10 G1 X1 Y2 F10\nN20 X2\nG21\nY3 ; mm now\n").unwrap();
+        let m = moves(&p);
+        assert_eq!(m.len(), 3);
+        assert!(!m[0].start_known);
+        assert_eq!(m[0].end, P3::new(25.4, 50.8, 0.0));
+        assert_eq!(m[0].modes.feed, Some(254.0));
+        assert_eq!(m[1].motion, Motion::Line);
+        assert!(!m[1].explicit);
+        assert_eq!(m[1].n, Some(20));
+        assert_eq!(m[1].end, P3::new(50.8, 50.8, 0.0));
+        assert_eq!(m[2].end, P3::new(50.8, 3.0, 0.0));
+        assert!(!m[2].plain, "a commented move is written back verbatim");
+    }
+
+    #[test]
+    fn arcs_by_offsets_and_radius() {
+        let p = parse("G0 X0 Y0 Z0\nG2 X10 Y0 I5 J0\nG3 X20 Y0 R5\nG2 X30 Y0 R-5\nG18 G3 X40 Z0 K0 I5\n").unwrap();
+        let m = moves(&p);
+        assert_eq!(m[1].centre, Some(P2::new(5.0, 0.0)));
+        assert!(m[1].start_known);
+        // G3 from (10,0) to (20,0) with R5: centre on the left of the chord, (15,0) (a half circle).
+        assert!((m[2].centre.unwrap() - P2::new(15.0, 0.0)).norm() < 1e-9);
+        assert_eq!(m[4].modes.plane, Plane::Xz);
+        // Plane xz: coordinates (z, x); centre at x = 30 + 5, z = 0.
+        assert_eq!(m[4].centre, Some(P2::new(0.0, 35.0)));
+        assert!(!m[4].plain, "G18 on the block makes it verbatim");
+    }
+
+    #[test]
+    fn relative_mode_and_e() {
+        let p = parse("M83\nG91\nG1 X1 Y1 E0.5\nX1 E0.25\nG90\nG1 X5 Y5\n").unwrap();
+        let m = moves(&p);
+        assert!(m[0].modes.e_relative);
+        assert_eq!(m[1].end, P3::new(2.0, 1.0, 0.0));
+        assert_eq!(m[1].e, Some(0.25));
+        assert!(!m[2].start_known, "leaving a made-up G91 frame forgets the position");
+    }
+
+    #[test]
+    fn opaque_blocks_are_kept_and_unknown_positions_marked() {
+        let p = parse("G0 X1 Y1 Z1\nM3 S1000\nG28\nG1 X2 Y2 Z2\nG92 E0\nG1 X3\n").unwrap();
+        assert_eq!(p.blocks.len(), 6);
+        let m = moves(&p);
+        assert!(m[0].plain);
+        assert!(!m[1].start_known);
+        assert!(m[2].start_known, "G92 E0 does not move the axes");
+    }
+
+    #[test]
+    fn malformed_words_are_errors_with_line_and_word() {
+        let e = parse("G1 X1\nG1 X1.2.3 Y2\n").unwrap_err();
+        assert_eq!(e.to_string(), "t.nc:2:4 (X1.2.3): malformed word");
+        let e = parse("G1 Xab\n").unwrap_err();
+        assert_eq!(e.to_string(), "t.nc:1:4 (Xab): malformed word: a letter must be followed by a number");
+        let e = parse("G1 X[1+2]\n").unwrap_err();
+        assert!(e.to_string().contains("parameters and expressions"), "{e}");
+        let e = parse("G1 X1 @5\n").unwrap_err();
+        assert_eq!(e.to_string(), "t.nc:1:7 (@5): unknown word");
+        assert_eq!(e.exit_status(), 2);
+        let e = parse("G1 X1 X2\n").unwrap_err();
+        assert!(e.to_string().contains("twice"), "{e}");
+    }
+}

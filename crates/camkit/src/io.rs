@@ -1,0 +1,125 @@
+//! Input from a path or standard input, and output written whole or not at all.
+
+use crate::error::{Error, Result};
+use std::io::{Read, Write};
+use std::path::{Path, PathBuf};
+
+/// A whole input, read into memory, with the name errors should show.
+#[derive(Clone, Debug)]
+pub struct Input {
+    /// The file name as given, `stdin` for standard input.
+    pub name: String,
+    /// The bytes.
+    pub data: Vec<u8>,
+}
+
+impl Input {
+    /// Reads `arg`: a path, or `-` for standard input.
+    pub fn open(arg: &str) -> Result<Input> {
+        if arg == "-" {
+            let mut data = Vec::new();
+            std::io::stdin().lock().read_to_end(&mut data).map_err(|e| Error::io(e, "stdin"))?;
+            return Ok(Input { name: "stdin".into(), data });
+        }
+        let data = std::fs::read(arg).map_err(|e| Error::io(e, &format!("cannot read {arg}")))?;
+        Ok(Input { name: arg.to_string(), data })
+    }
+
+    /// The input as text; invalid UTF-8 is an input error naming the line.
+    pub fn text(&self) -> Result<&str> {
+        std::str::from_utf8(&self.data).map_err(|e| {
+            let line = self.data[..e.valid_up_to()].iter().filter(|&&b| b == b'\n').count() as u64 + 1;
+            Error::input("text is not valid UTF-8").at(crate::error::Location::file(&self.name).line(line))
+        })
+    }
+
+    /// The file extension in lower case (empty for standard input).
+    pub fn extension(&self) -> String {
+        Path::new(&self.name).extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase()
+    }
+}
+
+/// Output collected in memory and delivered only on [`Output::commit`]: to a file through a
+/// temporary file renamed into place, or to standard output in one write. A run that fails
+/// before committing leaves no file and prints nothing.
+#[derive(Debug)]
+pub struct Output {
+    path: Option<PathBuf>,
+    /// The bytes to deliver.
+    pub buf: Vec<u8>,
+}
+
+impl Output {
+    /// Output to `path`, or to standard output when `None` or `-`.
+    pub fn new(path: Option<&Path>) -> Output {
+        let path = path.filter(|p| p.as_os_str() != "-").map(Path::to_path_buf);
+        Output { path, buf: Vec::with_capacity(1 << 16) }
+    }
+
+    /// Delivers the output.
+    pub fn commit(self) -> Result<()> {
+        match &self.path {
+            Some(path) => write_atomic(path, &self.buf),
+            None => {
+                let mut out = std::io::stdout().lock();
+                out.write_all(&self.buf).and_then(|_| out.flush()).map_err(|e| Error::io(e, "stdout"))
+            }
+        }
+    }
+}
+
+impl Write for Output {
+    fn write(&mut self, data: &[u8]) -> std::io::Result<usize> {
+        self.buf.extend_from_slice(data);
+        Ok(data.len())
+    }
+
+    fn flush(&mut self) -> std::io::Result<()> {
+        Ok(())
+    }
+}
+
+/// Writes `data` to `path` through a temporary file in the same directory, renamed into place,
+/// so readers see the old file or the whole new one.
+pub fn write_atomic(path: &Path, data: &[u8]) -> Result<()> {
+    let shown = path.display().to_string();
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
+        _ => PathBuf::from("."),
+    };
+    let mut tmp = tempfile::Builder::new()
+        .prefix(".camkit-")
+        .suffix(".tmp")
+        .tempfile_in(&dir)
+        .map_err(|e| Error::io(e, &format!("cannot write {shown}")))?;
+    tmp.write_all(data).and_then(|_| tmp.flush()).map_err(|e| Error::io(e, &format!("cannot write {shown}")))?;
+    tmp.persist(path).map_err(|e| Error::io(e.error, &format!("cannot write {shown}")))?;
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn output_file_appears_only_on_commit() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("out.csv");
+        let mut out = Output::new(Some(&path));
+        out.write_all(b"x,y\n").unwrap();
+        assert!(!path.exists());
+        out.commit().unwrap();
+        assert_eq!(std::fs::read(&path).unwrap(), b"x,y\n");
+        let mut dropped = Output::new(Some(&dir.path().join("never.csv")));
+        dropped.write_all(b"partial").unwrap();
+        drop(dropped);
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
+    }
+
+    #[test]
+    fn missing_input_is_an_input_error() {
+        let e = Input::open("/nonexistent/file.csv").unwrap_err();
+        assert_eq!(e.exit_status(), 2);
+        assert_eq!(e.to_string(), "cannot read /nonexistent/file.csv: No such file or directory");
+    }
+}

@@ -1,0 +1,145 @@
+//! The one list of toolpath-table columns: names, units, defaults and meanings. Both every
+//! filter's `--help` and `docs/formats.md` are made from it, so they cannot drift apart.
+
+/// A column the table reader understands and stores in typed fields of a [`super::Row`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+#[allow(missing_docs)] // each variant is documented by its entry in COLUMNS
+pub enum Col {
+    Path,
+    Move,
+    X,
+    Y,
+    Z,
+    Xc,
+    Yc,
+    Zc,
+    Plane,
+    I,
+    J,
+    K,
+    S,
+    F,
+    Px,
+    Py,
+    Pz,
+    Nx,
+    Ny,
+    Nz,
+    Tag,
+}
+
+/// Documentation of one column.
+#[derive(Clone, Copy, Debug)]
+pub struct ColumnSpec {
+    /// The column, if the reader stores it in a typed field; `None` for documented columns that
+    /// filters read or write by name (they travel in [`super::Row::extra`]).
+    pub col: Option<Col>,
+    /// Header name.
+    pub name: &'static str,
+    /// Unit, or the kind of value.
+    pub unit: &'static str,
+    /// Value when the column is absent or the field empty; `required` when it has none.
+    pub default: &'static str,
+    /// What the value means.
+    pub meaning: &'static str,
+}
+
+macro_rules! typed {
+    ($col:ident, $name:literal, $unit:literal, $default:literal, $meaning:literal) => {
+        ColumnSpec { col: Some(Col::$col), name: $name, unit: $unit, default: $default, meaning: $meaning }
+    };
+}
+
+/// Every column of the toolpath table, shared vocabulary first, in the canonical output order.
+pub const COLUMNS: &[ColumnSpec] = &[
+    typed!(Path, "path", "integer", "0", "id of one continuous pass; a new id starts a new pass"),
+    typed!(
+        Move,
+        "move",
+        "rapid|line|cw|ccw",
+        "line",
+        "G0/G1/G2/G3: the row is the end of a move from the previous row of its path"
+    ),
+    typed!(X, "x", "mm", "required", "position: tool tip for cutter streams, stylus centre in stylus-trace's stream"),
+    typed!(Y, "y", "mm", "required", "position"),
+    typed!(Z, "z", "mm", "0", "position"),
+    typed!(Xc, "xc", "mm", "required for cw/ccw", "arc centre, x"),
+    typed!(Yc, "yc", "mm", "required for cw/ccw", "arc centre, y"),
+    typed!(Zc, "zc", "mm", "required for cw/ccw in planes xz, yz", "arc centre, z (arcs in the xz or yz plane)"),
+    typed!(
+        Plane,
+        "plane",
+        "xy|xz|yz",
+        "xy",
+        "plane of a cw/ccw arc (G17/G18/G19); the coordinate normal to it varies linearly (helix)"
+    ),
+    typed!(I, "i", "unit vector", "0", "tool axis, x component"),
+    typed!(J, "j", "unit vector", "0", "tool axis, y component"),
+    typed!(K, "k", "unit vector", "1", "tool axis, z component"),
+    typed!(S, "s", "deg", "empty", "spindle orientation of a non-rotating tool"),
+    typed!(F, "f", "mm/min", "empty", "feed"),
+    typed!(Px, "px", "mm", "empty", "contact point, x"),
+    typed!(Py, "py", "mm", "empty", "contact point, y"),
+    typed!(Pz, "pz", "mm", "empty", "contact point, z"),
+    typed!(Nx, "nx", "unit vector", "empty", "unit surface normal at the contact point, x"),
+    typed!(Ny, "ny", "unit vector", "empty", "unit surface normal, y"),
+    typed!(Nz, "nz", "unit vector", "empty", "unit surface normal, z"),
+    typed!(Tag, "tag", "text", "empty", "free label (trochoid, contour, probe, ...)"),
+];
+
+/// The spec of a typed column.
+pub fn spec(col: Col) -> &'static ColumnSpec {
+    COLUMNS.iter().find(|s| s.col == Some(col)).expect("every Col has a spec")
+}
+
+/// The typed column with header `name`.
+pub fn by_name(name: &str) -> Option<Col> {
+    COLUMNS.iter().find(|s| s.name == name).and_then(|s| s.col)
+}
+
+/// Plain-text list of columns for a filter's `--help`: what it reads and what it writes.
+pub fn help_text(reads: &[Col], writes: &[Col]) -> String {
+    let mut out = String::from(
+        "Toolpath table columns (CSV, header row required, any order, `#` lines are comments;\nunknown columns pass through unchanged):\n",
+    );
+    let section = |out: &mut String, title: &str, cols: &[Col]| {
+        out.push_str(title);
+        out.push('\n');
+        for &c in cols {
+            let s = spec(c);
+            out.push_str(&format!("  {:<6} {:<18} {}", s.name, s.unit, s.meaning));
+            if s.default != "empty" {
+                out.push_str(&format!(" [{}]", s.default));
+            }
+            out.push('\n');
+        }
+    };
+    section(&mut out, "reads:", reads);
+    section(&mut out, "writes:", writes);
+    out
+}
+
+/// Markdown table of every column, for `docs/formats.md`.
+pub fn markdown_table() -> String {
+    let mut out = String::from("| column | unit | default | meaning |\n|---|---|---|---|\n");
+    for s in COLUMNS {
+        out.push_str(&format!("| `{}` | {} | {} | {} |\n", s.name, s.unit, s.default, s.meaning));
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn names_are_unique_and_resolvable() {
+        for (i, s) in COLUMNS.iter().enumerate() {
+            assert!(COLUMNS[i + 1..].iter().all(|t| t.name != s.name), "duplicate {}", s.name);
+            if let Some(c) = s.col {
+                assert_eq!(by_name(s.name), Some(c));
+                assert_eq!(spec(c).name, s.name);
+            }
+        }
+    }
+}
