@@ -7,12 +7,15 @@
 //! [`report`]), and SVG plots ([`svg`]). Nothing here is specific to one filter.
 
 pub mod cli;
+pub mod doc;
 pub mod error;
 pub mod gcode;
 pub mod geom;
 pub mod io;
+pub mod json;
 pub mod num;
 pub mod report;
+pub mod svg;
 pub mod table;
 pub mod tol;
 

@@ -128,6 +128,9 @@ pub struct MoveBlock {
     pub has_f: bool,
     /// E word value as written (increment or absolute, per `modes.e_relative`).
     pub e: Option<f64>,
+    /// Extrusion of this block (the increment), when it is known: always for relative E, for
+    /// absolute E once an earlier E or a G92 E gave the reference.
+    pub e_delta: Option<f64>,
     /// N block number.
     pub n: Option<u64>,
     /// True if the block holds nothing but the motion, its coordinates, F, E, N: a filter may
@@ -147,6 +150,8 @@ pub struct OtherBlock {
     pub modes: Modes,
     /// The block has a group-1 word (G0..G3, G80) that sets the modal motion.
     pub motion_word: bool,
+    /// The block has no words at all: blank, or only a comment.
+    pub remark_only: bool,
 }
 
 /// One line of a program.

@@ -77,6 +77,29 @@ fn parse_number(line: &[u8], mut i: usize) -> Option<(f64, usize, u32)> {
     Some((if neg { -value } else { value }, i, decimals))
 }
 
+/// The M code of a block that starts with an M word (after an optional N word).
+fn m_led(line: &[u8]) -> Option<u32> {
+    let mut i = 0;
+    let skip_space = |i: &mut usize| {
+        while *i < line.len() && line[*i].is_ascii_whitespace() {
+            *i += 1;
+        }
+    };
+    skip_space(&mut i);
+    if i < line.len() && line[i].eq_ignore_ascii_case(&b'N') {
+        i += 1;
+        while i < line.len() && line[i].is_ascii_digit() {
+            i += 1;
+        }
+        skip_space(&mut i);
+    }
+    if i < line.len() && line[i].eq_ignore_ascii_case(&b'M') {
+        let digits: String = line[i + 1..].iter().take_while(|c| c.is_ascii_digit()).map(|&c| c as char).collect();
+        return digits.parse().ok();
+    }
+    None
+}
+
 /// Reads a whole program. `name` is used in error messages.
 pub fn read(name: &str, source: String) -> Result<Program> {
     let mut reader = Reader {
@@ -86,6 +109,7 @@ pub fn read(name: &str, source: String) -> Result<Program> {
         known: [false; 3],
         virtual_frame: false,
         e_mode_relative: false,
+        e_abs: None,
     };
     let mut blocks = Vec::with_capacity(source.len() / 24 + 1);
     let mut decimals = Decimals::default();
@@ -119,6 +143,8 @@ struct Reader<'a> {
     virtual_frame: bool,
     /// M83 in effect.
     e_mode_relative: bool,
+    /// Absolute extruder position, when known.
+    e_abs: Option<f64>,
 }
 
 /// What the G words of a block ask for, beyond modal settings.
@@ -300,13 +326,38 @@ impl Reader<'_> {
         let first = line.iter().position(|b| !b.is_ascii_whitespace());
         // Blank lines, block delete and tape marks are not interpreted.
         if first.is_none_or(|i| matches!(line[i], b'/' | b'%')) {
-            return Ok(Block::Other(OtherBlock { line: line_no, span, modes: self.modes, motion_word: false }));
+            let remark_only = first.is_none();
+            return Ok(Block::Other(OtherBlock {
+                line: line_no,
+                span,
+                modes: self.modes,
+                motion_word: false,
+                remark_only,
+            }));
+        }
+        if let Some(code) = m_led(line) {
+            // An M block (Marlin's M84 X Y E, M117 free text...): its parameters are not
+            // coordinates and need not be numbers. Only the extruder mode is read from it.
+            match code {
+                82 => self.e_mode_relative = false,
+                83 => self.e_mode_relative = true,
+                _ => {}
+            }
+            self.modes.e_relative = self.e_mode_relative || self.modes.relative;
+            return Ok(Block::Other(OtherBlock {
+                line: line_no,
+                span,
+                modes: self.modes,
+                motion_word: false,
+                remark_only: false,
+            }));
         }
         let remark = self.words(line, line_no, words)?;
         let fx = self.apply_modal(words, line, line_no)?;
         let motion_word =
             fx.motion.is_some() || words.iter().any(|w| w.letter == b'G' && (w.value * 10.0).round() as i64 == 800);
-        let other = |span, modes| Ok(Block::Other(OtherBlock { line: line_no, span, modes, motion_word }));
+        let remark_only = words.is_empty();
+        let other = |span, modes| Ok(Block::Other(OtherBlock { line: line_no, span, modes, motion_word, remark_only }));
         if words.is_empty() {
             return other(span, self.modes);
         }
@@ -348,6 +399,18 @@ impl Reader<'_> {
         }
         let has_axes = axes.iter().any(Option::is_some);
         let g92_only_e = fx.g92 && !has_axes;
+        let e_delta = match e {
+            Some(v) if fx.g92 => {
+                self.e_abs = Some(v);
+                None
+            }
+            Some(v) if self.modes.e_relative => {
+                self.e_abs = self.e_abs.map(|a| a + v);
+                Some(v)
+            }
+            Some(v) => self.e_abs.replace(v).map(|prev| v - prev),
+            None => None,
+        };
         if fx.moves_unmodelled || (fx.g92 && !g92_only_e) {
             // G28, G53, G92 with axes, G43, canned cycles...: where the machine is afterwards is not known.
             self.known = [false; 3];
@@ -412,6 +475,7 @@ impl Reader<'_> {
             modes: self.modes,
             has_f: f.is_some(),
             e,
+            e_delta,
             n,
             plain,
         }))
@@ -518,13 +582,21 @@ mod tests {
         assert!(m[0].modes.e_relative);
         assert_eq!(m[1].end, P3::new(2.0, 1.0, 0.0));
         assert_eq!(m[1].e, Some(0.25));
+        assert_eq!(m[1].e_delta, Some(0.25));
+        let p = parse("M82\nG92 E0\nG1 X1 E1.5\nG1 X2 E2.25\nG92 E10\nG1 X3 E11\n").unwrap();
+        let d: Vec<_> = moves(&p).iter().map(|m| m.e_delta).collect();
+        assert_eq!(d, vec![Some(1.5), Some(0.75), Some(1.0)]);
         assert!(!m[2].start_known, "leaving a made-up G91 frame forgets the position");
     }
 
     #[test]
     fn opaque_blocks_are_kept_and_unknown_positions_marked() {
-        let p = parse("G0 X1 Y1 Z1\nM3 S1000\nG28\nG1 X2 Y2 Z2\nG92 E0\nG1 X3\n").unwrap();
-        assert_eq!(p.blocks.len(), 6);
+        let p = parse(
+            "G0 X1 Y1 Z1\nM3 S1000\nG28\nG1 X2 Y2 Z2\nG92 E0\nM201 X500 Y500\nG1 X3\nM84 X Y E\nM117 Hello world\n",
+        )
+        .unwrap();
+        assert_eq!(p.blocks.len(), 9);
+        assert!(matches!(p.blocks[5], Block::Other(_)), "M201's X and Y are parameters");
         let m = moves(&p);
         assert!(m[0].plain);
         assert!(!m[1].start_known);

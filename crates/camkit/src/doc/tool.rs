@@ -1,0 +1,109 @@
+//! The tool document: what cuts, and its dimensions.
+
+use crate::error::Result;
+use crate::json::field_error;
+use serde::{Deserialize, Serialize};
+
+/// The shape of a tool.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum ToolKind {
+    /// Ball end mill: a hemisphere of `radius` at the tip.
+    Ball,
+    /// Square (flat) end mill of `radius`.
+    Flat,
+    /// Bull-nose end mill: flat bottom with `corner_radius` corners.
+    Bull,
+    /// Non-rotating cylindrical tool (paper 000 §2.1): the rim of a cylinder of `radius` cut square.
+    CylindricalNonrotating,
+    /// Non-rotating flat-type tool (paper 000 §3.2(2)): a wedge whose tip traces a concave line.
+    FlatNonrotating,
+}
+
+/// A tool.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Tool {
+    /// Shape.
+    pub kind: ToolKind,
+    /// Radius R (mm): of the ball, the cutter, or the cylinder.
+    pub radius: f64,
+    /// Corner radius of a bull-nose tool (mm).
+    #[serde(default)]
+    pub corner_radius: f64,
+    /// Radius of a small flat ground at a ball end mill's tip, r0 of paper 003 (mm).
+    #[serde(default)]
+    pub tip_flat_radius: f64,
+    /// Number of flutes (rotating tools).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub flutes: Option<u32>,
+    /// Length from the gauge line to the tip (mm).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub length: Option<f64>,
+    /// Tool number for the tool change (T word).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub number: Option<u32>,
+}
+
+impl Tool {
+    /// Checks the dimensions; errors name the file and field.
+    pub fn validate(&self, file: &str) -> Result<()> {
+        let positive = |v: f64| v.is_finite() && v > 0.0;
+        if !positive(self.radius) {
+            return Err(field_error(
+                file,
+                "radius",
+                format!("radius must be a positive number of mm, got {}", self.radius),
+            ));
+        }
+        if !(self.corner_radius >= 0.0 && self.corner_radius <= self.radius) {
+            return Err(field_error(file, "corner_radius", "corner_radius must be between 0 and radius"));
+        }
+        if self.kind == ToolKind::Bull && self.corner_radius == 0.0 {
+            return Err(field_error(file, "corner_radius", "a bull-nose tool needs corner_radius > 0"));
+        }
+        if !(self.tip_flat_radius >= 0.0 && self.tip_flat_radius < self.radius) {
+            return Err(field_error(file, "tip_flat_radius", "tip_flat_radius must be at least 0 and below radius"));
+        }
+        if self.flutes == Some(0) {
+            return Err(field_error(file, "flutes", "a tool needs at least one flute"));
+        }
+        if self.length.is_some_and(|l| !positive(l)) {
+            return Err(field_error(file, "length", "length must be positive"));
+        }
+        Ok(())
+    }
+
+    /// Reads and validates a tool document.
+    pub fn read(path: &str) -> Result<Tool> {
+        let input = crate::io::Input::open(path)?;
+        let tool: Tool = crate::json::from_input(&input)?;
+        tool.validate(&input.name)?;
+        Ok(tool)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn parse(text: &str) -> Result<Tool> {
+        let input = crate::io::Input { name: "t.json".into(), data: text.as_bytes().to_vec() };
+        let t: Tool = crate::json::from_input(&input)?;
+        t.validate(&input.name)?;
+        Ok(t)
+    }
+
+    #[test]
+    fn reads_and_checks() {
+        let t = parse(r#"{"kind": "ball", "radius": 5, "flutes": 2}"#).unwrap();
+        assert_eq!(t.kind, ToolKind::Ball);
+        assert_eq!(t.flutes, Some(2));
+        let e = parse(r#"{"kind": "ball", "radius": -1}"#).unwrap_err();
+        assert_eq!(e.to_string(), "t.json (radius): radius must be a positive number of mm, got -1");
+        let e = parse(r#"{"kind": "drill", "radius": 1}"#).unwrap_err();
+        assert!(e.to_string().starts_with("t.json:1:16 (kind): unknown variant `drill`"), "{e}");
+        let e = parse(r#"{"kind": "bull", "radius": 5}"#).unwrap_err();
+        assert!(e.to_string().contains("(corner_radius)"), "{e}");
+    }
+}

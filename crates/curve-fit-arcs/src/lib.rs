@@ -1,0 +1,122 @@
+//! `curve-fit-arcs`: compresses point sequences (toolpath tables, G-code) into lines and arcs
+//! whose distance from the input, measured after rounding to the output's decimals, never
+//! exceeds the tolerance (paper 004 §2).
+//!
+//! A *run* is a stretch of input that may be merged: consecutive feed moves of one pass with the
+//! same feed, tool axis and extrusion rate. Each run is cut into pieces ([`segment`]), each piece
+//! fitted as a line or an arc through its end points ([`fit`]) and measured ([`deviation`]).
+
+pub mod deviation;
+pub mod fit;
+pub mod gcode_runs;
+pub mod plot;
+pub mod segment;
+pub mod table_runs;
+
+use camkit::geom::{P3, Plane};
+
+/// How runs are cut into pieces.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Method {
+    /// The longest piece that fits from each start (fewest moves).
+    #[default]
+    Fewest,
+    /// Paper 004's grouping by curvature threshold, split where a point strays beyond tolerance.
+    Paper,
+}
+
+/// Settings of a fit.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Options {
+    /// Largest Hausdorff distance between output and input (mm).
+    pub tol: f64,
+    /// Segmentation method.
+    pub method: Method,
+    /// Planes arcs may lie in, tried in order.
+    pub planes: Vec<Plane>,
+    /// Smallest arc radius written (mm).
+    pub min_radius: f64,
+    /// Largest arc radius written (mm); flatter runs become lines.
+    pub max_radius: f64,
+    /// Largest angle one arc may sweep (radians).
+    pub max_sweep: f64,
+    /// Tangent continuity between pieces: largest change of direction at a joint (radians).
+    pub tangent: Option<f64>,
+    /// Turning angle (radians) above which a point is a corner no piece spans.
+    pub corner: f64,
+    /// Curvature (1/mm) at or above which the paper method groups points into arcs.
+    pub curvature_threshold: f64,
+    /// Largest relative difference of extrusion per mm between moves merged into one.
+    pub e_rate_tol: f64,
+}
+
+impl Default for Options {
+    fn default() -> Self {
+        Options {
+            tol: 0.01,
+            method: Method::Fewest,
+            planes: vec![Plane::Xy],
+            min_radius: 0.0,
+            max_radius: 10_000.0,
+            max_sweep: 350f64.to_radians(),
+            tangent: None,
+            corner: 60f64.to_radians(),
+            curvature_threshold: 1e-3,
+            e_rate_tol: 0.05,
+        }
+    }
+}
+
+/// Figures of a fit, summed over runs.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Stats {
+    /// Motion moves in the input (G0..G3 blocks or table rows).
+    pub input_moves: usize,
+    /// Motion moves in the output.
+    pub output_moves: usize,
+    /// Line pieces written for merged runs.
+    pub lines: usize,
+    /// Arc pieces written.
+    pub arcs: usize,
+    /// Points fitted (in runs).
+    pub points: usize,
+    /// Repeated identical points dropped.
+    pub dropped_repeats: usize,
+    /// Largest verified deviation of any piece (mm).
+    pub largest_deviation: f64,
+}
+
+impl Stats {
+    /// Input moves per output move.
+    pub fn ratio(&self) -> f64 {
+        if self.output_moves == 0 { 1.0 } else { self.input_moves as f64 / self.output_moves as f64 }
+    }
+
+    fn add_pieces(&mut self, pieces: &[fit::Piece]) {
+        for p in pieces {
+            match p.shape {
+                fit::Shape::Line => self.lines += 1,
+                fit::Shape::Arc { .. } => self.arcs += 1,
+            }
+            self.largest_deviation = self.largest_deviation.max(p.deviation);
+        }
+    }
+}
+
+/// One fitted run kept for plotting: its points and pieces.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FittedRun {
+    /// The run's points.
+    pub pts: Vec<P3>,
+    /// Its pieces.
+    pub pieces: Vec<fit::Piece>,
+}
+
+/// Appends `p` to `pts` unless it repeats the last point; returns false if it was dropped.
+fn push_distinct(pts: &mut Vec<P3>, p: P3) -> bool {
+    if pts.last().is_some_and(|q| (q - p).norm() <= camkit::tol::POINT_EPS) {
+        return false;
+    }
+    pts.push(p);
+    true
+}

@@ -1,0 +1,275 @@
+//! `curve-fit-arcs`: point streams and G-code to lines and arcs within a proven tolerance.
+
+use camkit::cli::{self, IoArgs};
+use camkit::error::{Error, Location, Result};
+use camkit::geom::Plane;
+use camkit::io::{Input, Output, write_atomic};
+use camkit::report::Report;
+use camkit::table::{self, Col, WriteOptions};
+use clap::{Parser, ValueEnum};
+use curve_fit_arcs::gcode_runs::{self, Format};
+use curve_fit_arcs::{Method, Options, Stats, plot, table_runs};
+use std::path::PathBuf;
+use std::process::ExitCode;
+use std::time::Instant;
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+enum Kind {
+    /// Decide by the file extension (.nc .ngc .gcode .gco .g .tap .cnc are G-code).
+    Auto,
+    /// The toolpath table (CSV).
+    Table,
+    /// G-code.
+    Gcode,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+enum MethodArg {
+    /// Longest piece that fits from each start: fewest moves.
+    Fewest,
+    /// Paper 004's curvature grouping (for comparison).
+    Paper,
+}
+
+#[derive(Parser, Debug)]
+#[command(
+    name = "curve-fit-arcs",
+    version,
+    allow_negative_numbers = true,
+    about = "Compress point sequences and G-code into lines and arcs (G1/G2/G3) within a guaranteed tolerance.",
+    long_about = "Compress point sequences and G-code into lines and arcs (G1/G2/G3) within a guaranteed \
+tolerance (paper 004 §2). Every input point and chord lies within --tol of the output and every output \
+point within --tol of the input, measured exactly after rounding to the output's decimals. Moves are never \
+merged across a change of path, rapid moves, feed, tool axis, spindle orientation or tag, nor across G-code \
+blocks the filter does not model (they are written back verbatim, in order).",
+    after_help = after_help()
+)]
+struct Args {
+    #[command(flatten)]
+    io: IoArgs,
+    /// Input format.
+    #[arg(long, value_enum, default_value_t = Kind::Auto)]
+    from: Kind,
+    /// Output format (auto: the input's).
+    #[arg(long, value_enum, default_value_t = Kind::Auto)]
+    to: Kind,
+    /// Tolerance (mm): largest distance between output and input, both ways.
+    #[arg(long, default_value_t = 0.01, value_name = "MM")]
+    tol: f64,
+    /// Segmentation method.
+    #[arg(long, value_enum, default_value_t = MethodArg::Fewest)]
+    method: MethodArg,
+    /// Plane of arcs: xy, xz, yz, or auto (each run in whichever plane fits).
+    #[arg(long, default_value = "xy", value_name = "PLANE")]
+    plane: String,
+    /// Smallest arc radius (mm).
+    #[arg(long, default_value_t = 0.0, value_name = "MM")]
+    min_radius: f64,
+    /// Largest arc radius (mm); flatter stretches become lines.
+    #[arg(long, default_value_t = 10_000.0, value_name = "MM")]
+    max_radius: f64,
+    /// Largest sweep of one arc (degrees, below 360).
+    #[arg(long, default_value_t = 350.0, value_name = "DEG")]
+    max_sweep: f64,
+    /// Keep tangent continuity between pieces: largest change of direction at a joint (degrees).
+    #[arg(long, value_name = "DEG")]
+    tangent: Option<f64>,
+    /// Turning angle (degrees) above which a point is a corner, kept sharp.
+    #[arg(long, default_value_t = 60.0, value_name = "DEG")]
+    corner: f64,
+    /// Curvature threshold (1/mm) of the paper method: at or above it points group into arcs.
+    #[arg(long, default_value_t = 1e-3, value_name = "1/MM")]
+    curvature_threshold: f64,
+    /// Largest relative difference of extrusion per mm between G-code moves merged into one.
+    #[arg(long, default_value_t = 0.05, value_name = "FRACTION")]
+    e_rate_tol: f64,
+    /// Decimals of written positions (default: G-code keeps the input's, at least 3 (mm) or 4
+    /// (inch); tables are written exactly).
+    #[arg(long, value_name = "N")]
+    decimals: Option<u32>,
+    /// Write an SVG of the input points and the fitted lines and arcs.
+    #[arg(long, value_name = "FILE")]
+    svg: Option<PathBuf>,
+}
+
+fn after_help() -> String {
+    let mut s = table::columns::help_text(
+        &[Col::Path, Col::Move, Col::X, Col::Y, Col::Z, Col::I, Col::J, Col::K, Col::S, Col::F, Col::Tag],
+        &[Col::Move, Col::X, Col::Y, Col::Z, Col::Xc, Col::Yc, Col::Zc, Col::Plane],
+    );
+    s.push_str("Other columns pass through; a merged row keeps the values of the input row it ends at.\n\n");
+    s.push_str("G-code: G0/G1/G2/G3 (I/J/K or R), G17/G18/G19, G20/G21, G90/G91, G90.1/G91.1, F, E (M82/M83), N,\n");
+    s.push_str("( ) and ; comments, modal moves. E is summed over merged moves (relative) or carried (absolute).\n");
+    s.push_str("\nExit status: 0 done, 1 a check failed, 2 bad input or usage.");
+    s
+}
+
+fn main() -> ExitCode {
+    cli::run("curve-fit-arcs", || run(Args::parse()))
+}
+
+fn usage(message: String) -> Error {
+    Error::input(message)
+}
+
+fn options(args: &Args) -> Result<Options> {
+    let finite_pos = |v: f64, what: &str| {
+        if v.is_finite() && v > 0.0 { Ok(v) } else { Err(usage(format!("{what} must be a positive number, got {v}"))) }
+    };
+    let tol = finite_pos(args.tol, "--tol")?;
+    let planes = match args.plane.as_str() {
+        "auto" => vec![Plane::Xy, Plane::Xz, Plane::Yz],
+        p => vec![Plane::parse(p).ok_or_else(|| usage(format!("--plane must be xy, xz, yz or auto, got {p}")))?],
+    };
+    if !(args.min_radius >= 0.0 && args.max_radius > args.min_radius && args.max_radius.is_finite()) {
+        return Err(usage("--min-radius and --max-radius must satisfy 0 ≤ min < max".into()));
+    }
+    if !(args.max_sweep > 0.0 && args.max_sweep < 360.0) {
+        return Err(usage("--max-sweep must be between 0 and 360 degrees".into()));
+    }
+    if let Some(t) = args.tangent {
+        if !(0.0..90.0).contains(&t) {
+            return Err(usage("--tangent must be an angle from 0 to 90 degrees".into()));
+        }
+        if planes.len() > 1 {
+            return Err(usage("--tangent needs one arc plane, not --plane auto".into()));
+        }
+    }
+    if args.decimals.is_some_and(|d| d > 12) {
+        return Err(usage("--decimals must be at most 12".into()));
+    }
+    Ok(Options {
+        tol,
+        method: match args.method {
+            MethodArg::Fewest => Method::Fewest,
+            MethodArg::Paper => Method::Paper,
+        },
+        planes,
+        min_radius: args.min_radius,
+        max_radius: args.max_radius,
+        max_sweep: args.max_sweep.to_radians(),
+        tangent: args.tangent.map(f64::to_radians),
+        corner: finite_pos(args.corner, "--corner")?.to_radians(),
+        curvature_threshold: finite_pos(args.curvature_threshold, "--curvature-threshold")?,
+        e_rate_tol: finite_pos(args.e_rate_tol, "--e-rate-tol")?,
+    })
+}
+
+fn is_gcode_name(input: &Input) -> bool {
+    matches!(input.extension().as_str(), "nc" | "ngc" | "gcode" | "gco" | "g" | "tap" | "cnc")
+}
+
+fn run(args: Args) -> Result<()> {
+    let opts = options(&args)?;
+    let started = Instant::now();
+    let input = Input::open(&args.io.input)?;
+    let from = match args.from {
+        Kind::Auto if is_gcode_name(&input) => Kind::Gcode,
+        Kind::Auto => Kind::Table,
+        k => k,
+    };
+    let to = if args.to == Kind::Auto { from } else { args.to };
+    let bytes_in = input.data.len();
+    let mut out = Output::new(args.io.output.as_deref());
+    let (stats, runs) = if from == Kind::Gcode {
+        let source = input.text()?.to_string();
+        if source.trim().is_empty() {
+            return Err(Error::input("empty input: no G-code").at(Location::file(&input.name)));
+        }
+        let program = camkit::gcode::read(&input.name, source)?;
+        if to == Kind::Gcode {
+            let mut format = Format::of(&program);
+            if let Some(d) = args.decimals {
+                format.decimals = d;
+                format.centre_decimals = d + 1;
+            }
+            let (text, stats, runs) = gcode_runs::fit_program(&program, &opts, format)
+                .map_err(|e| unfittable(&input.name, u64::from(e.line), e.cause.deviation, &opts))?;
+            out.buf = text;
+            (stats, runs)
+        } else {
+            let (t, skipped) = camkit::gcode::program_to_table(&program);
+            if skipped > 0 {
+                cli::warn(&format!(
+                    "{skipped} non-motion blocks (comments, M/S/T words, other G codes) are not carried into the table"
+                ));
+            }
+            fit_to_table(&t, &opts, &args, &input, &mut out)?
+        }
+    } else {
+        let t = table::read(&input, &[Col::X, Col::Y])?;
+        let distinct = t.rows.windows(2).filter(|w| (w[0].pos - w[1].pos).norm() > camkit::tol::POINT_EPS).count() + 1;
+        if t.rows.is_empty() || distinct < 2 {
+            let what = if t.rows.is_empty() { "no points" } else { "a single point" };
+            return Err(Error::input(format!("{what}: at least two distinct points are needed"))
+                .at(Location::file(&input.name)));
+        }
+        if to == Kind::Gcode {
+            let d = args.decimals.unwrap_or(4);
+            let (fitted, stats, runs) = table_runs::fit_table(&t, &opts, Some(d))
+                .map_err(|e| unfittable(&input.name, e.line, e.cause.deviation, &opts))?;
+            out.buf = camkit::gcode::table_to_program(&fitted, &input.name, d)?;
+            (stats, runs)
+        } else {
+            fit_to_table(&t, &opts, &args, &input, &mut out)?
+        }
+    };
+    if !camkit::tol::within(stats.largest_deviation, opts.tol) {
+        return Err(Error::check(format!(
+            "largest deviation {:.6} mm exceeds --tol {} mm",
+            stats.largest_deviation, opts.tol
+        )));
+    }
+    let seconds = started.elapsed().as_secs_f64();
+    if let Some(path) = &args.svg {
+        let plane = opts.planes[0];
+        let title =
+            format!("{}: {} moves → {} (tol {} mm)", input.name, stats.input_moves, stats.output_moves, opts.tol);
+        write_atomic(path, plot::plot(&runs, plane, &title).to_svg(1000.0).as_bytes())?;
+    }
+    if let Some(path) = &args.io.report {
+        report(&stats, &opts, seconds, bytes_in, out.buf.len()).write(path)?;
+    }
+    out.commit()
+}
+
+fn fit_to_table(
+    t: &table::Table,
+    opts: &Options,
+    args: &Args,
+    input: &Input,
+    out: &mut Output,
+) -> Result<(Stats, Vec<curve_fit_arcs::FittedRun>)> {
+    let (fitted, stats, runs) = table_runs::fit_table(t, opts, args.decimals)
+        .map_err(|e| unfittable(&input.name, e.line, e.cause.deviation, opts))?;
+    table::write(out, &fitted, &WriteOptions { decimals: args.decimals })?;
+    Ok((stats, runs))
+}
+
+fn unfittable(file: &str, line: u64, deviation: f64, opts: &Options) -> Error {
+    Error::input(format!(
+        "a single move deviates {deviation:.6} mm from the input once rounded, more than --tol {} mm: write more --decimals",
+        opts.tol
+    ))
+    .at(Location::file(file).line(line))
+}
+
+fn report(stats: &Stats, opts: &Options, seconds: f64, bytes_in: usize, bytes_out: usize) -> Report {
+    let mut r = Report::new("curve-fit-arcs");
+    r.set("method", format!("{:?}", opts.method).to_lowercase())
+        .set("tol_mm", opts.tol)
+        .set("input_moves", stats.input_moves)
+        .set("output_moves", stats.output_moves)
+        .set("compression_ratio", stats.ratio())
+        .set("lines", stats.lines)
+        .set("arcs", stats.arcs)
+        .set("largest_deviation_mm", stats.largest_deviation)
+        .set("points", stats.points)
+        .set("dropped_repeats", stats.dropped_repeats)
+        .set("seconds", seconds)
+        .set("points_per_second", stats.points as f64 / seconds.max(1e-9))
+        .set("bytes_in", bytes_in)
+        .set("bytes_out", bytes_out)
+        .set("mb_per_second", bytes_in as f64 / 1e6 / seconds.max(1e-9));
+    r
+}

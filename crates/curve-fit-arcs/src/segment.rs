@@ -1,0 +1,184 @@
+//! Cutting a run of points into pieces: the fewest-moves search, and paper 004's curvature
+//! grouping for comparison.
+
+use crate::fit::{self, Job, Piece, Rounding, Tangent};
+use crate::{Method, Options};
+use camkit::geom::{P3, circle};
+
+/// Why a run could not be cut within the tolerance.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Unfittable {
+    /// Index of the point whose chord alone exceeds the tolerance once rounded.
+    pub at: usize,
+    /// That chord's deviation (mm).
+    pub deviation: f64,
+}
+
+/// Cuts `pts` (one run, no repeated points) into pieces that each stay within `opts.tol`.
+pub fn segment(pts: &[P3], opts: &Options, rounding: &dyn Rounding) -> Result<Vec<Piece>, Unfittable> {
+    if pts.len() < 2 {
+        return Ok(Vec::new());
+    }
+    let corners = corners(pts, opts.corner, opts.tol);
+    match opts.method {
+        Method::Fewest => fewest(pts, &corners, opts, rounding),
+        Method::Paper => paper(pts, &corners, opts, rounding),
+    }
+}
+
+/// `true` at the interior points where the path turns by more than `limit` radians between
+/// two chords longer than `tol`: a corner seen at the tolerance's scale. (A jog of a few microns
+/// in a noisy program turns sharply too, but it is noise a fit may smooth within `tol`.)
+fn corners(pts: &[P3], limit: f64, tol: f64) -> Vec<bool> {
+    let mut out = vec![false; pts.len()];
+    for k in 1..pts.len() - 1 {
+        let a = pts[k] - pts[k - 1];
+        let b = pts[k + 1] - pts[k];
+        out[k] = a.norm() > tol && b.norm() > tol && a.angle(&b) > limit;
+    }
+    out
+}
+
+/// The tangent the piece after `prev` must follow.
+fn tangent_after(prev: Option<&Piece>, corners: &[bool], opts: &Options) -> Option<Tangent> {
+    let max_angle = opts.tangent?;
+    let prev = prev?;
+    if corners[prev.last] {
+        return None;
+    }
+    let plane = opts.planes[0];
+    let dir = prev.end_tangent(plane)?;
+    Some(Tangent { dir, max_angle, plane })
+}
+
+/// Where the piece after `prev` starts, as written.
+fn start_after(prev: Option<&Piece>, pts: &[P3], rounding: &dyn Rounding) -> P3 {
+    prev.map_or_else(|| rounding.point(&pts[0]), |p| p.end)
+}
+
+/// The shortest single move from `first`: one chord to the next point, as a line.
+fn single(pts: &[P3], first: usize, start: P3, opts: &Options, rounding: &dyn Rounding) -> Result<Piece, Unfittable> {
+    let relaxed = Options { tol: f64::INFINITY, ..opts.clone() };
+    let job = Job { pts, first, last: first + 1, start, fixed_end: true, tangent: None };
+    let piece = fit::line(&job, &relaxed, rounding).ok_or(Unfittable { at: first, deviation: f64::INFINITY })?;
+    if piece.deviation > opts.tol {
+        return Err(Unfittable { at: first, deviation: piece.deviation });
+    }
+    Ok(piece)
+}
+
+/// Greedy longest valid piece from each start: galloping then binary search for the farthest
+/// end that fits, then a short look past the first failure (validity is not always monotone in
+/// the end index). When validity is monotone (any piece inside a valid one is valid), greedy
+/// longest-first is optimal for the number of pieces.
+fn fewest(pts: &[P3], corners: &[bool], opts: &Options, rounding: &dyn Rounding) -> Result<Vec<Piece>, Unfittable> {
+    const LOOK_PAST: usize = 3;
+    let n = pts.len();
+    let mut pieces: Vec<Piece> = Vec::new();
+    let mut first = 0;
+    while first < n - 1 {
+        // A piece never spans a corner, and ends exactly on corners and at the run's end.
+        let limit = (first + 1..n).find(|&k| k == n - 1 || corners[k]).unwrap_or(n - 1);
+        let tangent = tangent_after(pieces.last(), corners, opts);
+        let start = start_after(pieces.last(), pts, rounding);
+        let try_fit = |last: usize| {
+            let job = Job { pts, first, last, start, fixed_end: true, tangent };
+            fit::best(&job, opts, rounding)
+        };
+        let mut good = match try_fit(first + 1) {
+            Some(p) => p,
+            // Tangent continuity cannot hold here (a turn below the corner angle): start afresh.
+            None => single(pts, first, start, opts, rounding)?,
+        };
+        let mut lo = first + 1;
+        loop {
+            // Gallop.
+            let mut step = 1;
+            let mut hi = None;
+            while lo < limit {
+                let j = (lo + step).min(limit);
+                match try_fit(j) {
+                    Some(p) => {
+                        good = p;
+                        lo = j;
+                        step *= 2;
+                    }
+                    None => {
+                        hi = Some(j);
+                        break;
+                    }
+                }
+            }
+            // Binary search between the last fit and the first failure.
+            if let Some(mut hi) = hi {
+                while hi - lo > 1 {
+                    let mid = lo + (hi - lo) / 2;
+                    match try_fit(mid) {
+                        Some(p) => {
+                            good = p;
+                            lo = mid;
+                        }
+                        None => hi = mid,
+                    }
+                }
+            }
+            // Look past the failure.
+            match (lo + 2..=(lo + 1 + LOOK_PAST).min(limit)).rev().find_map(try_fit) {
+                Some(p) => {
+                    lo = p.last;
+                    good = p;
+                }
+                None => break,
+            }
+        }
+        first = good.last;
+        pieces.push(good);
+    }
+    Ok(pieces)
+}
+
+/// Paper 004 §2: the curvature of each point from the circle through it and its neighbours;
+/// consecutive points at or over the threshold are grouped and approximated by arcs, those under
+/// it by lines; a group is split where a point strays beyond the tolerance.
+fn paper(pts: &[P3], corners: &[bool], opts: &Options, rounding: &dyn Rounding) -> Result<Vec<Piece>, Unfittable> {
+    let n = pts.len();
+    let plane = opts.planes[0];
+    let flat: Vec<_> = pts.iter().map(|p| plane.split(p).0).collect();
+    let mut curved = vec![false; n];
+    for k in 1..n - 1 {
+        curved[k] = circle::curvature(&flat[k - 1], &flat[k], &flat[k + 1]).abs() >= opts.curvature_threshold;
+    }
+    if n > 2 {
+        curved[0] = curved[1];
+        curved[n - 1] = curved[n - 2];
+    }
+    let mut pieces: Vec<Piece> = Vec::new();
+    let mut first = 0;
+    while first < n - 1 {
+        // The group: points of the same class as `first`, up to a corner.
+        let mut end = first + 1;
+        while end < n - 1 && curved[end] == curved[first] && !corners[end] {
+            end += 1;
+        }
+        let tangent = tangent_after(pieces.last(), corners, opts);
+        let start = start_after(pieces.last(), pts, rounding);
+        // The paper's pieces run through the points: every end is a point.
+        let try_fit = |last: usize| {
+            let job = Job { pts, first, last, start, fixed_end: true, tangent };
+            if curved[first] { fit::arc(&job, plane, opts, rounding) } else { fit::line(&job, opts, rounding) }
+        };
+        let mut good = match try_fit(first + 1) {
+            Some(p) => p,
+            None => single(pts, first, start, opts, rounding)?,
+        };
+        for last in first + 2..=end {
+            match try_fit(last) {
+                Some(p) => good = p,
+                None => break,
+            }
+        }
+        first = good.last;
+        pieces.push(good);
+    }
+    Ok(pieces)
+}
