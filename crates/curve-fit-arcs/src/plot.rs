@@ -19,33 +19,41 @@ pub fn plot(runs: &[FittedRun], plane: Plane, title: &str) -> Plot {
     let names = ["x", "y", "z"];
     p.labels(&format!("{} (mm)", names[u]), &format!("{} (mm)", names[v]));
     let total: usize = runs.iter().map(|r| r.pts.len()).sum();
+    if total <= MAX_DOTS {
+        for run in runs {
+            let flat: Vec<_> = run.pts.iter().map(|q| plane.split(q).0).collect();
+            p.dots(&flat, 1.0, Style::fill("#999", 0.7));
+        }
+    }
+    let mut joints = Vec::new();
     for run in runs {
-        let flat: Vec<_> = run.pts.iter().map(|q| plane.split(q).0).collect();
         for piece in &run.pieces {
+            joints.push(plane.split(&piece.start).0);
             let a = plane.split(&piece.start).0;
             let b = plane.split(&piece.end).0;
             match piece.shape {
                 Shape::Line => {
-                    p.polyline(&[a, b], Style::stroke(LINE, 1.6));
+                    p.polyline(&[a, b], Style::stroke(LINE, 2.2));
                 }
                 Shape::Arc { centre, plane: arc_plane, ccw } => {
                     // Arcs in another plane are drawn by their end points only.
                     if arc_plane == plane {
                         let arc = Arc2::from_centre(centre, &a, &b, ccw, false);
-                        p.path(a, vec![Piece::Arc(arc)], false, Style::stroke(ARC, 1.6));
+                        p.path(a, vec![Piece::Arc(arc)], false, Style::stroke(ARC, 2.2));
                     } else {
-                        p.polyline(&[a, b], Style::stroke(ARC, 1.6).dashed("3 2"));
+                        p.polyline(&[a, b], Style::stroke(ARC, 2.2).dashed("3 2"));
                     }
                 }
             }
-        }
-        if total <= MAX_DOTS {
-            p.dots(&flat, 1.3, Style::fill("#444", 0.8));
+            joints.push(b);
         }
     }
-    p.legend("line", Style::stroke(LINE, 1.6)).legend("arc", Style::stroke(ARC, 1.6));
+    p.dots(&joints, 2.2, Style::fill("black", 1.0));
+    p.legend("line", Style::stroke(LINE, 2.2))
+        .legend("arc", Style::stroke(ARC, 2.2))
+        .legend("piece ends", Style::fill("black", 1.0));
     if total <= MAX_DOTS {
-        p.legend("input points", Style::fill("#444", 0.8));
+        p.legend("input points", Style::fill("#999", 0.7));
     }
     p
 }

@@ -50,7 +50,16 @@ macro_rules! typed {
     };
 }
 
-/// Every column of the toolpath table, shared vocabulary first, in the canonical output order.
+/// A column that travels in [`super::Row::extra`]: named here so it is documented once.
+#[allow(unused_macros)] // used as filters name their own columns
+macro_rules! named {
+    ($name:literal, $unit:literal, $default:literal, $meaning:literal) => {
+        ColumnSpec { col: None, name: $name, unit: $unit, default: $default, meaning: $meaning }
+    };
+}
+
+/// Every column of the toolpath table: the shared vocabulary (typed) in the canonical output
+/// order, then the columns particular filters read or write by name.
 pub const COLUMNS: &[ColumnSpec] = &[
     typed!(Path, "path", "integer", "0", "id of one continuous pass; a new id starts a new pass"),
     typed!(
@@ -123,7 +132,8 @@ pub fn help_text(reads: &[Col], writes: &[Col]) -> String {
 pub fn markdown_table() -> String {
     let mut out = String::from("| column | unit | default | meaning |\n|---|---|---|---|\n");
     for s in COLUMNS {
-        out.push_str(&format!("| `{}` | {} | {} | {} |\n", s.name, s.unit, s.default, s.meaning));
+        let cell = |t: &str| t.replace('|', "\\|");
+        out.push_str(&format!("| `{}` | {} | {} | {} |\n", s.name, cell(s.unit), cell(s.default), cell(s.meaning)));
     }
     out
 }
@@ -131,6 +141,22 @@ pub fn markdown_table() -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// `docs/formats.md` holds the generated table between its markers; `make docs` rewrites it.
+    #[test]
+    fn docs_in_sync() {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../docs/formats.md");
+        let text = std::fs::read_to_string(&path).expect("docs/formats.md");
+        let (begin, end) = ("<!-- columns:begin -->\n", "<!-- columns:end -->");
+        let a = text.find(begin).expect("begin marker") + begin.len();
+        let b = text.find(end).expect("end marker");
+        let table = markdown_table();
+        if std::env::var_os("UPDATE_DOCS").is_some() {
+            std::fs::write(&path, format!("{}{}{}", &text[..a], table, &text[b..])).expect("write docs");
+        } else {
+            assert_eq!(&text[a..b], table, "docs/formats.md is out of date: run `make docs`");
+        }
+    }
 
     #[test]
     fn names_are_unique_and_resolvable() {

@@ -1,0 +1,60 @@
+# The CAM toolkit: build, test, demo parts, benchmarks.
+#   make demo    every demo part into out/<part>/ (one rule per pipeline stage)
+#   make test    all unit, property and end-to-end tests
+#   make check   formatting, clippy -D warnings, then the tests
+# Demo parameters are variables: `make demo-sine SINE_TOL=0.001`.
+
+SHELL := bash
+.SHELLFLAGS := -eu -o pipefail -c
+.DELETE_ON_ERROR:
+.SUFFIXES:
+MAKEFLAGS += --no-builtin-rules --warn-undefined-variables
+
+CARGO ?= cargo
+RELEASE := target/release
+OUT := out
+
+# Each demo part's pipeline is a fragment mk/<part>.mk that adds itself to DEMOS and the filters
+# it runs to FILTERS; stage rules depend on $(RELEASE)/<filter>, which cargo keeps up to date.
+FILTERS :=
+DEMOS :=
+include $(sort $(wildcard mk/*.mk))
+BINS := $(addprefix $(RELEASE)/,$(sort $(FILTERS)))
+
+.PHONY: all build test lint check fmt docs demo bench clean FORCE
+all: build
+
+build: $(BINS)
+
+$(BINS): FORCE
+	$(CARGO) build --release --bins
+
+test:
+	$(CARGO) build --bins
+	$(CARGO) test --workspace
+
+lint:
+	$(CARGO) fmt --all -- --check
+	$(CARGO) clippy --workspace --all-targets -- -D warnings
+
+check: lint test
+
+fmt:
+	$(CARGO) fmt --all
+
+# Regenerates the parts of docs/formats.md made from the code (the toolpath columns).
+docs:
+	UPDATE_DOCS=1 $(CARGO) test -p camkit --lib docs_in_sync
+
+demo: $(addprefix demo-,$(DEMOS))
+
+bench:
+	$(CARGO) bench --workspace
+	scripts/bench-arcwelder.sh
+
+clean:
+	rm -rf $(OUT)
+	$(CARGO) clean
+
+%/:
+	mkdir -p $@
