@@ -1,13 +1,11 @@
 //! Fitting one piece to a range of points: a line or an arc from the written end of the piece
-//! before it, ending either exactly at the range's last point (at corners and run ends) or at the
-//! point of the fitted line or circle nearest to it (elsewhere: the joint may sit anywhere
-//! within the tolerance, which lets pieces run longer). Arc centres are least-squares, refined to
-//! minimax when least squares misses the tolerance; every candidate is measured as written.
+//! before it to the range's last point (as written). Arc centres lie on the bisector of the two
+//! ends: the least-squares one, refined to minimax when least squares misses the tolerance by a
+//! little. Every candidate is measured as it will be written.
 
 use crate::Options;
 use crate::deviation::{self, Helix};
-use camkit::geom::{P2, P3, Plane, V2, V3, arc::angle_between};
-use nalgebra::{Matrix2, Matrix3, Vector2};
+use camkit::geom::{P2, P3, Plane, V2, arc::angle_between, cross2};
 
 /// How the written program rounds what the fitter chooses.
 pub trait Rounding {
@@ -102,7 +100,7 @@ impl Tangent {
     }
 }
 
-/// What a candidate piece is fitted to.
+/// What a candidate piece is fitted to: points `first..=last` of a run, from a written start.
 pub struct Job<'a> {
     /// The run's points.
     pub pts: &'a [P3],
@@ -110,12 +108,12 @@ pub struct Job<'a> {
     pub first: usize,
     /// Last point of the piece.
     pub last: usize,
-    /// The written start.
+    /// The written start (the previous piece's end).
     pub start: P3,
-    /// End exactly at `pts[last]` (rounded) rather than where the fit is best.
-    pub fixed_end: bool,
     /// Tangent continuity with the previous piece.
     pub tangent: Option<Tangent>,
+    /// Also try the minimax centre when least squares misses (slower, a little longer pieces).
+    pub thorough: bool,
 }
 
 impl Job<'_> {
@@ -124,69 +122,22 @@ impl Job<'_> {
     }
 }
 
-/// Minimax solution of the linear residuals `aₖ − Bₖ·x` by Lawson's iteratively reweighted
-/// least squares, starting from `x` (the least-squares solution).
-fn lawson<const D: usize>(
-    rows: &[(f64, nalgebra::SVector<f64, D>)],
-    mut x: nalgebra::SVector<f64, D>,
-) -> nalgebra::SVector<f64, D> {
-    const ITERATIONS: usize = 24;
-    let mut w = vec![1.0 / rows.len() as f64; rows.len()];
-    for _ in 0..ITERATIONS {
-        let res: Vec<f64> = rows.iter().map(|(a, b)| (a - b.dot(&x)).abs()).collect();
-        let total: f64 = w.iter().zip(&res).map(|(w, r)| w * r).sum();
-        if total <= 0.0 {
-            break;
-        }
-        for (wk, rk) in w.iter_mut().zip(&res) {
-            *wk *= rk / total;
-        }
-        let mut m = nalgebra::SMatrix::<f64, D, D>::zeros();
-        let mut v = nalgebra::SVector::<f64, D>::zeros();
-        for ((a, b), wk) in rows.iter().zip(&w) {
-            m += b * b.transpose() * *wk;
-            v += b * (*a * *wk);
-        }
-        match m.try_inverse() {
-            Some(inv) => x = inv * v,
-            None => break,
-        }
-    }
-    x
-}
-
 /// Tries a line.
 pub fn line(job: &Job, opts: &Options, rounding: &dyn Rounding) -> Option<Piece> {
     let pts = job.span();
     let a = job.start;
-    let target = pts[pts.len() - 1];
-    let b = if job.fixed_end {
-        rounding.point(&target)
-    } else {
-        // The least-squares line through the start; the end is the last point's projection.
-        let mut m = Matrix3::zeros();
-        for p in pts {
-            let d = p - a;
-            m += d * d.transpose();
-        }
-        let chord = target - a;
-        let eig = m.symmetric_eigen();
-        let (k, _) = eig
-            .eigenvalues
-            .iter()
-            .enumerate()
-            .fold((0, f64::MIN), |best, (i, v)| if *v > best.1 { (i, *v) } else { best });
-        let u: V3 = eig.eigenvectors.column(k).into_owned();
-        let u = if u.dot(&chord) < 0.0 { -u } else { u };
-        rounding.point(&(a + u * chord.dot(&u)))
-    };
+    let b = rounding.point(&pts[pts.len() - 1]);
     if let Some(t) = &job.tangent {
         let dir = camkit::geom::dist::unit2(&(t.plane.split(&b).0 - t.plane.split(&a).0))?;
         if !t.allows(&dir) {
             return None;
         }
     }
-    let deviation = deviation::line(pts, &a, &b);
+    // Quick rejection on the middle point before the full measure.
+    if camkit::geom::dist::point_segment(&pts[pts.len() / 2], &a, &b) > opts.tol {
+        return None;
+    }
+    let deviation = deviation::line(pts, &a, &b, opts.tol);
     (deviation <= opts.tol).then_some(Piece {
         first: job.first,
         last: job.last,
@@ -197,166 +148,195 @@ pub fn line(job: &Job, opts: &Options, rounding: &dyn Rounding) -> Option<Piece>
     })
 }
 
-/// Tries an arc in `plane` (at least three points): least-squares centre, then minimax if
-/// that misses the tolerance, then (with tangent continuity) the arc tangent to the previous
-/// piece.
+/// Least squares misses by at most this share of the tolerance before minimax is tried.
+const MINIMAX_REACH: f64 = 0.5;
+
+/// Tries an arc in `plane` (at least three points): least-squares centre, then (for a thorough
+/// job) minimax if that misses the tolerance by a little, then (with tangent continuity) the
+/// arc tangent to the previous piece.
 pub fn arc(job: &Job, plane: Plane, opts: &Options, rounding: &dyn Rounding) -> Option<Piece> {
     if job.last < job.first + 2 {
         return None;
     }
     let pts = job.span();
     let (s, _) = plane.split(&job.start);
-    let target = pts[pts.len() - 1];
-    let flat: Vec<P2> = pts[1..].iter().map(|p| plane.split(p).0).collect();
-    let fixed_end = job.fixed_end.then(|| plane.split(&rounding.point(&target)).0);
-    let centres = CentreFit::new(&s, fixed_end.as_ref(), &flat)?;
-    let mut tried = centres.least_squares().and_then(|c| arc_about(job, plane, c, opts, rounding));
-    if tried.is_none() {
-        tried = centres.minimax().and_then(|c| arc_about(job, plane, c, opts, rounding));
+    let (e, _) = plane.split(&rounding.point(&pts[pts.len() - 1]));
+    let bisector = Bisector::new(&s, &e)?;
+    let inner = || pts[1..pts.len() - 1].iter().map(|p| plane.split(p).0);
+    let reach = opts.tol * (1.0 + MINIMAX_REACH);
+    let (piece, dev) = match bisector.least_squares(inner()) {
+        Some(c) => arc_about(job, plane, c, opts, rounding, reach),
+        None => (None, f64::INFINITY),
+    };
+    if piece.is_some() {
+        return piece;
     }
-    if tried.is_none()
-        && let Some(t) = job.tangent.as_ref().filter(|t| t.plane == plane)
-    {
-        let through = fixed_end.unwrap_or(flat[flat.len() - 1]);
-        let c = camkit::geom::circle::tangent_through(&s, &t.dir, &through)?;
-        tried = arc_about(job, plane, c.c, opts, rounding);
+    if job.thorough && dev <= reach {
+        let rows: Vec<(f64, f64)> = inner().map(|p| bisector.row(&p)).collect();
+        if let Some(c) = bisector.minimax(&rows) {
+            let (piece, _) = arc_about(job, plane, c, opts, rounding, opts.tol);
+            if piece.is_some() {
+                return piece;
+            }
+        }
     }
-    tried
+    let t = job.tangent.as_ref().filter(|t| t.plane == plane)?;
+    let c = camkit::geom::circle::tangent_through(&s, &t.dir, &e)?;
+    arc_about(job, plane, c.c, opts, rounding, opts.tol).0
 }
 
-/// Centres of circles through the start (and the fixed end, if any) fitted to points, as the
-/// linear residuals of `|p − c|² − |s − c|²` (about `2r` times the geometric distance).
-struct CentreFit {
-    /// Residual rows in the free parameters.
-    rows: Vec<(f64, Vector2<f64>)>,
-    /// Maps the free parameters to a centre.
-    origin: P2,
-    /// With a fixed end: the unit normal of the chord (one free parameter along it).
-    normal: Option<V2>,
+/// Centres of circles through the two ends `s`, `e`: `c(t) = m + t·n` on the bisector. The
+/// algebraic residual `|p − c|² − |s − c|² = a − t·b` of a point is linear in `t` (and about
+/// `2r` times its geometric distance).
+struct Bisector {
+    m: P2,
+    n: V2,
+    h2: f64,
 }
 
-impl CentreFit {
-    fn new(s: &P2, fixed_end: Option<&P2>, pts: &[P2]) -> Option<CentreFit> {
-        match fixed_end {
-            Some(e) => {
-                // Centres on the bisector m + t·n: residual |p−m|² − h² − 2t n·(p−m).
-                let chord = e - s;
-                let len = chord.norm();
-                if len == 0.0 {
-                    return None;
-                }
-                let m = P2::from((s.coords + e.coords) * 0.5);
-                let n = V2::new(-chord.y, chord.x) / len;
-                let h2 = 0.25 * len * len;
-                let rows = pts[..pts.len() - 1]
-                    .iter()
-                    .map(|p| {
-                        let d = p - m;
-                        (d.norm_squared() - h2, Vector2::new(2.0 * n.dot(&d), 0.0))
-                    })
-                    .collect();
-                Some(CentreFit { rows, origin: m, normal: Some(n) })
-            }
-            None => {
-                // Centres c = s + x: residual |q|² − 2 x·q with q = p − s.
-                let rows = pts
-                    .iter()
-                    .map(|p| {
-                        let q = p - s;
-                        (q.norm_squared(), 2.0 * q)
-                    })
-                    .collect();
-                Some(CentreFit { rows, origin: *s, normal: None })
-            }
-        }
-    }
-
-    fn centre(&self, x: &Vector2<f64>) -> P2 {
-        match self.normal {
-            Some(n) => self.origin + n * x.x,
-            None => self.origin + x,
-        }
-    }
-
-    fn least_squares(&self) -> Option<P2> {
-        let mut m = Matrix2::zeros();
-        let mut v = Vector2::zeros();
-        for (a, b) in &self.rows {
-            m += b * b.transpose();
-            v += b * *a;
-        }
-        let x = if self.normal.is_some() {
-            if m[(0, 0)] <= 0.0 {
-                return None;
-            }
-            Vector2::new(v.x / m[(0, 0)], 0.0)
-        } else {
-            m.try_inverse()? * v
-        };
-        Some(self.centre(&x))
-    }
-
-    fn minimax(&self) -> Option<P2> {
-        let ls = self.least_squares()?;
-        Some(match self.normal {
-            Some(n) => {
-                let rows: Vec<(f64, nalgebra::Vector1<f64>)> =
-                    self.rows.iter().map(|(a, b)| (*a, nalgebra::Vector1::new(b.x))).collect();
-                let x0 = nalgebra::Vector1::new((ls - self.origin).dot(&n));
-                self.origin + n * lawson(&rows, x0).x
-            }
-            None => self.centre(&lawson(&self.rows, ls - self.origin)),
+impl Bisector {
+    fn new(s: &P2, e: &P2) -> Option<Bisector> {
+        let chord = e - s;
+        let len = chord.norm();
+        (len > 0.0).then(|| Bisector {
+            m: P2::from((s.coords + e.coords) * 0.5),
+            n: V2::new(-chord.y, chord.x) / len,
+            h2: 0.25 * len * len,
         })
     }
+
+    /// The residual row `(a, b)` of a point.
+    fn row(&self, p: &P2) -> (f64, f64) {
+        let d = p - self.m;
+        (d.norm_squared() - self.h2, 2.0 * self.n.dot(&d))
+    }
+
+    fn least_squares(&self, pts: impl Iterator<Item = P2>) -> Option<P2> {
+        let (mut sab, mut sbb) = (0.0, 0.0);
+        for p in pts {
+            let (a, b) = self.row(&p);
+            sab += a * b;
+            sbb += b * b;
+        }
+        (sbb > 0.0).then(|| self.m + self.n * (sab / sbb))
+    }
+
+    /// The minimax `t` by Lawson's iteratively reweighted least squares.
+    fn minimax(&self, rows: &[(f64, f64)]) -> Option<P2> {
+        const ITERATIONS: usize = 10;
+        let mut w = vec![1.0; rows.len()];
+        let mut t = 0.0;
+        for _ in 0..ITERATIONS {
+            let (mut sab, mut sbb) = (0.0, 0.0);
+            for ((a, b), wk) in rows.iter().zip(&w) {
+                sab += wk * a * b;
+                sbb += wk * b * b;
+            }
+            if sbb <= 0.0 {
+                return None;
+            }
+            t = sab / sbb;
+            let total: f64 = rows.iter().zip(&w).map(|((a, b), wk)| wk * (a - b * t).abs()).sum();
+            if total <= 0.0 {
+                break;
+            }
+            for ((a, b), wk) in rows.iter().zip(w.iter_mut()) {
+                *wk *= (a - b * t).abs() / total;
+            }
+        }
+        Some(self.m + self.n * t)
+    }
 }
 
-/// The arc piece about centre `c`, if it meets every constraint.
-fn arc_about(job: &Job, plane: Plane, c: P2, opts: &Options, rounding: &dyn Rounding) -> Option<Piece> {
+/// The arc piece about centre `c` and its deviation, if it meets every constraint. The measure
+/// stops as soon as it exceeds `limit` (at least the tolerance, so a stopped measure never
+/// passes for a fit).
+fn arc_about(
+    job: &Job,
+    plane: Plane,
+    c: P2,
+    opts: &Options,
+    rounding: &dyn Rounding,
+    limit: f64,
+) -> (Option<Piece>, f64) {
+    let limit = limit.max(opts.tol);
+    let none = (None, f64::INFINITY);
     let pts = job.span();
     let a = job.start;
+    let b = rounding.point(&pts[pts.len() - 1]);
     let (pa, _) = plane.split(&a);
-    let target = pts[pts.len() - 1];
-    let b = if job.fixed_end {
-        rounding.point(&target)
-    } else {
-        // The point of the circle (at the target's height along the plane normal) nearest the target.
-        let (t, w) = plane.split(&target);
-        let r = (pa - c).norm();
-        let dir = camkit::geom::dist::unit2(&(t - c))?;
-        rounding.point(&plane.join(&(c + dir * r), w))
-    };
-    let r = 0.5 * ((pa - c).norm() + (plane.split(&b).0 - c).norm());
+    let r = (pa - c).norm();
     if r < opts.min_radius || r > opts.max_radius || !r.is_finite() {
-        return None;
+        return none;
     }
     let centre = rounding.centre(&c, &pa);
-    // The sense is the way the points wind about the centre.
-    let mut turn = 0.0;
-    let mut prev = pa - centre;
-    for p in &pts[1..] {
-        let v = plane.split(p).0 - centre;
-        turn += angle_between(&prev, &v);
-        prev = v;
+    // Quick rejection on three inner points before the full measure.
+    let n = pts.len() - 1;
+    for k in [n / 2, n / 4, 3 * n / 4] {
+        if k > 0 && k < n && ((plane.split(&pts[k]).0 - centre).norm() - r).abs() > limit {
+            return none;
+        }
     }
-    if turn.abs() > opts.max_sweep || turn == 0.0 {
-        return None;
+    // Three points of an arc under a full turn, in order, turn the way the arc does; if the
+    // points do not lie on such an arc, the measure finds the winding wrong.
+    let (pm, _) = plane.split(&pts[n / 2]);
+    let (pb, _) = plane.split(&b);
+    let turn = cross2(&(pm - pa), &(pb - pm));
+    if turn == 0.0 {
+        return none;
     }
-    let ccw = turn > 0.0;
-    let helix = Helix { plane, start: a, end: b, centre, ccw };
+    let helix = Helix { plane, start: a, end: b, centre, ccw: turn > 0.0 };
+    if !deviation::sweep_within(&helix, &V2::new(opts.max_sweep.cos(), opts.max_sweep.sin())) {
+        return none;
+    }
     if let Some(t) = job.tangent.as_ref()
         && t.plane == plane
         && !t.allows(&deviation::start_tangent(&helix))
     {
-        return None;
+        return none;
     }
-    let deviation = deviation::helix(pts, &helix);
-    (deviation <= opts.tol).then_some(Piece {
+    let deviation = deviation::helix(pts, &helix, limit);
+    let piece = (deviation <= opts.tol).then_some(Piece {
         first: job.first,
         last: job.last,
         start: a,
         end: b,
-        shape: Shape::Arc { centre, plane, ccw },
+        shape: Shape::Arc { centre, plane, ccw: helix.ccw },
         deviation,
+    });
+    (piece, deviation)
+}
+
+/// Points a probe looks at: about this many, spread evenly over the piece.
+const PROBE_POINTS: usize = 16;
+
+/// A quick guess whether a piece would fit: a line, or the least-squares arc of a subsample of
+/// the points, within the tolerance at those points. Not a proof (chords, winding and the points
+/// between are not looked at): the search uses it to find where to measure exactly.
+pub fn probe(job: &Job, opts: &Options, rounding: &dyn Rounding) -> bool {
+    let pts = job.span();
+    let n = pts.len() - 1;
+    let a = job.start;
+    let b = rounding.point(&pts[n]);
+    let step = (n / PROBE_POINTS).max(1);
+    let sample = || (step..n).step_by(step).map(|k| &pts[k]);
+    if sample().all(|p| camkit::geom::dist::point_segment(p, &a, &b) <= opts.tol) {
+        return true;
+    }
+    if n < 2 {
+        return false;
+    }
+    opts.planes.iter().any(|&plane| {
+        let (s, _) = plane.split(&a);
+        let (e, _) = plane.split(&b);
+        let Some(c) = Bisector::new(&s, &e).and_then(|bis| bis.least_squares(sample().map(|p| plane.split(p).0)))
+        else {
+            return false;
+        };
+        let r = (s - c).norm();
+        r >= opts.min_radius
+            && r <= opts.max_radius
+            && sample().all(|p| ((plane.split(p).0 - c).norm() - r).abs() <= opts.tol)
     })
 }
 

@@ -30,11 +30,14 @@ pub fn segment(pts: &[P3], opts: &Options, rounding: &dyn Rounding) -> Result<Ve
 /// two chords longer than `tol`: a corner seen at the tolerance's scale. (A jog of a few microns
 /// in a noisy program turns sharply too, but it is noise a fit may smooth within `tol`.)
 fn corners(pts: &[P3], limit: f64, tol: f64) -> Vec<bool> {
+    let cos_limit = limit.cos();
     let mut out = vec![false; pts.len()];
     for k in 1..pts.len() - 1 {
         let a = pts[k] - pts[k - 1];
         let b = pts[k + 1] - pts[k];
-        out[k] = a.norm() > tol && b.norm() > tol && a.angle(&b) > limit;
+        let (la, lb) = (a.norm(), b.norm());
+        // The turn exceeds `limit` when cos(turn) = a·b / (|a| |b|) is below cos(limit).
+        out[k] = la > tol && lb > tol && a.dot(&b) < cos_limit * la * lb;
     }
     out
 }
@@ -59,7 +62,7 @@ fn start_after(prev: Option<&Piece>, pts: &[P3], rounding: &dyn Rounding) -> P3 
 /// The shortest single move from `first`: one chord to the next point, as a line.
 fn single(pts: &[P3], first: usize, start: P3, opts: &Options, rounding: &dyn Rounding) -> Result<Piece, Unfittable> {
     let relaxed = Options { tol: f64::INFINITY, ..opts.clone() };
-    let job = Job { pts, first, last: first + 1, start, fixed_end: true, tangent: None };
+    let job = Job { pts, first, last: first + 1, start, tangent: None, thorough: false };
     let piece = fit::line(&job, &relaxed, rounding).ok_or(Unfittable { at: first, deviation: f64::INFINITY })?;
     if piece.deviation > opts.tol {
         return Err(Unfittable { at: first, deviation: piece.deviation });
@@ -67,53 +70,44 @@ fn single(pts: &[P3], first: usize, start: P3, opts: &Options, rounding: &dyn Ro
     Ok(piece)
 }
 
-/// Greedy longest valid piece from each start: galloping then binary search for the farthest
-/// end that fits, then a short look past the first failure (validity is not always monotone in
-/// the end index). When validity is monotone (any piece inside a valid one is valid), greedy
-/// longest-first is optimal for the number of pieces.
+/// Greedy longest valid piece from each start. A cheap probe ([`fit::probe`]) finds the farthest
+/// end that seems to fit (a first try at the previous piece's length, then galloping and binary
+/// search); that end is measured exactly, and if the measure disagrees an exact binary search
+/// runs below it. Then a short look past the end, measured exactly with minimax centres too
+/// (validity is not always monotone in the end index). When validity is monotone (any piece
+/// inside a valid one is valid), greedy longest-first is optimal for the number of pieces.
 fn fewest(pts: &[P3], corners: &[bool], opts: &Options, rounding: &dyn Rounding) -> Result<Vec<Piece>, Unfittable> {
     const LOOK_PAST: usize = 3;
     let n = pts.len();
+    // A piece never spans a corner: the first corner (or the end) after each point.
+    let mut next_stop = vec![n - 1; n];
+    for k in (1..n - 1).rev() {
+        next_stop[k - 1] = if corners[k] { k } else { next_stop[k] };
+    }
     let mut pieces: Vec<Piece> = Vec::new();
     let mut first = 0;
     while first < n - 1 {
-        // A piece never spans a corner, and ends exactly on corners and at the run's end.
-        let limit = (first + 1..n).find(|&k| k == n - 1 || corners[k]).unwrap_or(n - 1);
+        let limit = next_stop[first];
         let tangent = tangent_after(pieces.last(), corners, opts);
         let start = start_after(pieces.last(), pts, rounding);
-        let try_fit = |last: usize| {
-            let job = Job { pts, first, last, start, fixed_end: true, tangent };
-            fit::best(&job, opts, rounding)
-        };
-        let mut good = match try_fit(first + 1) {
+        let job = |last: usize, thorough: bool| Job { pts, first, last, start, tangent, thorough };
+        let exact = |last: usize, thorough: bool| fit::best(&job(last, thorough), opts, rounding);
+        let probe = |last: usize| fit::probe(&job(last, false), opts, rounding);
+        let guess = pieces.last().map(|p| first + (p.last - p.first));
+        let reach = farthest(first + 1, limit, guess, probe);
+        // Measure the probe's answer; if it does not hold, search below it exactly.
+        let mut good = match exact(reach, false) {
             Some(p) => p,
-            // Tangent continuity cannot hold here (a turn below the corner angle): start afresh.
-            None => single(pts, first, start, opts, rounding)?,
-        };
-        let mut lo = first + 1;
-        loop {
-            // Gallop.
-            let mut step = 1;
-            let mut hi = None;
-            while lo < limit {
-                let j = (lo + step).min(limit);
-                match try_fit(j) {
-                    Some(p) => {
-                        good = p;
-                        lo = j;
-                        step *= 2;
-                    }
-                    None => {
-                        hi = Some(j);
-                        break;
-                    }
-                }
-            }
-            // Binary search between the last fit and the first failure.
-            if let Some(mut hi) = hi {
+            None => {
+                let floor = match exact(first + 1, false) {
+                    Some(p) => p,
+                    // Tangent continuity cannot hold here (a turn below the corner angle): start afresh.
+                    None => single(pts, first, start, opts, rounding)?,
+                };
+                let (mut lo, mut hi, mut good) = (first + 1, reach, floor);
                 while hi - lo > 1 {
                     let mid = lo + (hi - lo) / 2;
-                    match try_fit(mid) {
+                    match exact(mid, false) {
                         Some(p) => {
                             good = p;
                             lo = mid;
@@ -121,20 +115,53 @@ fn fewest(pts: &[P3], corners: &[bool], opts: &Options, rounding: &dyn Rounding)
                         None => hi = mid,
                     }
                 }
+                good
             }
-            // Look past the failure.
-            match (lo + 2..=(lo + 1 + LOOK_PAST).min(limit)).rev().find_map(try_fit) {
-                Some(p) => {
-                    lo = p.last;
-                    good = p;
-                }
-                None => break,
-            }
+        };
+        // Look past the end: a few points further, and the next point with a minimax centre.
+        let lo = good.last;
+        let further = (lo + 2..=(lo + 1 + LOOK_PAST).min(limit)).rev().find_map(|j| exact(j, false));
+        if let Some(p) = further.or_else(|| (lo < limit).then(|| exact(lo + 1, true)).flatten()) {
+            good = p;
         }
         first = good.last;
         pieces.push(good);
     }
     Ok(pieces)
+}
+
+/// The largest `j` in `lo..=limit` for which `fits(j)` holds, assuming it holds at `lo` and is
+/// mostly monotone: a first try at `guess`, then galloping and binary search.
+fn farthest(lo: usize, limit: usize, guess: Option<usize>, fits: impl Fn(usize) -> bool) -> usize {
+    let (mut lo, mut hi) = (lo, None);
+    if let Some(g) = guess.map(|g| g.min(limit)).filter(|&g| g > lo) {
+        if fits(g) {
+            lo = g;
+        } else {
+            hi = Some(g);
+        }
+    }
+    let mut step = 1;
+    while hi.is_none() && lo < limit {
+        let j = (lo + step).min(limit);
+        if fits(j) {
+            lo = j;
+            step *= 2;
+        } else {
+            hi = Some(j);
+        }
+    }
+    if let Some(mut hi) = hi {
+        while hi - lo > 1 {
+            let mid = lo + (hi - lo) / 2;
+            if fits(mid) {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+    }
+    lo
 }
 
 /// Paper 004 §2: the curvature of each point from the circle through it and its neighbours;
@@ -164,7 +191,7 @@ fn paper(pts: &[P3], corners: &[bool], opts: &Options, rounding: &dyn Rounding) 
         let start = start_after(pieces.last(), pts, rounding);
         // The paper's pieces run through the points: every end is a point.
         let try_fit = |last: usize| {
-            let job = Job { pts, first, last, start, fixed_end: true, tangent };
+            let job = Job { pts, first, last, start, tangent, thorough: true };
             if curved[first] { fit::arc(&job, plane, opts, rounding) } else { fit::line(&job, opts, rounding) }
         };
         let mut good = match try_fit(first + 1) {

@@ -34,6 +34,7 @@ pub enum Plane {
 
 impl Plane {
     /// Indices of (u, v, w) in (x, y, z).
+    #[inline]
     pub fn axes(self) -> [usize; 3] {
         match self {
             Plane::Xy => [0, 1, 2],
@@ -43,12 +44,17 @@ impl Plane {
     }
 
     /// The in-plane point of `p` and its coordinate along the plane's normal.
+    #[inline]
     pub fn split(self, p: &P3) -> (P2, f64) {
-        let [u, v, w] = self.axes();
-        (P2::new(p[u], p[v]), p[w])
+        match self {
+            Plane::Xy => (P2::new(p.x, p.y), p.z),
+            Plane::Xz => (P2::new(p.z, p.x), p.y),
+            Plane::Yz => (P2::new(p.y, p.z), p.x),
+        }
     }
 
     /// The point with in-plane position `q` and normal coordinate `w`.
+    #[inline]
     pub fn join(self, q: &P2, w: f64) -> P3 {
         let [iu, iv, iw] = self.axes();
         let mut p = P3::origin();
