@@ -13,6 +13,7 @@ pub mod gcode;
 pub mod geom;
 pub mod io;
 pub mod json;
+pub mod model;
 pub mod num;
 pub mod report;
 pub mod svg;

@@ -1,6 +1,7 @@
 //! The JSON documents filters exchange besides the toolpath table. Each is a serde type read with
 //! [`crate::json`] (errors name the JSON path) and checked by `validate` (errors name the field).
 
+pub mod model;
 pub mod tool;
 
 pub use tool::{Tool, ToolKind};

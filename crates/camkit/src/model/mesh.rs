@@ -1,0 +1,314 @@
+//! Triangle meshes: STL reading (binary and ASCII, through `stl_io`) with errors that name the
+//! facet, and exact nearest points through a [`Bvh`] over the triangles.
+
+use super::analytic::Foot;
+use super::bvh::{Aabb, Bvh};
+use crate::error::{Error, Location, Result};
+use crate::geom::{P3, V3};
+use crate::io::Input;
+
+/// A triangle ready for distance queries.
+#[derive(Clone, Copy, Debug)]
+struct Tri {
+    a: P3,
+    ab: V3,
+    ac: V3,
+    /// Unit normal by the right-hand rule on the corners' order.
+    n: V3,
+}
+
+/// A triangle mesh with its spatial index.
+#[derive(Clone, Debug)]
+pub struct Mesh {
+    tris: Vec<Tri>,
+    index: Bvh,
+}
+
+/// The result of a mesh query: the foot and the triangle (its number in the input, from 0).
+#[derive(Clone, Copy, Debug)]
+pub struct MeshFoot {
+    /// Nearest point and the face normal there.
+    pub foot: Foot,
+    /// Input number of the triangle holding it.
+    pub triangle: usize,
+}
+
+/// Closest point of triangle (a, a+ab, a+ac) to p (Ericson, Real-Time Collision Detection 5.1.5).
+#[inline]
+fn closest_on_triangle(p: &P3, t: &Tri) -> P3 {
+    let (a, ab, ac) = (t.a, t.ab, t.ac);
+    let ap = p - a;
+    let d1 = ab.dot(&ap);
+    let d2 = ac.dot(&ap);
+    if d1 <= 0.0 && d2 <= 0.0 {
+        return a;
+    }
+    let bp = ap - ab;
+    let d3 = ab.dot(&bp);
+    let d4 = ac.dot(&bp);
+    if d3 >= 0.0 && d4 <= d3 {
+        return a + ab;
+    }
+    let vc = d1 * d4 - d3 * d2;
+    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
+        return a + ab * (d1 / (d1 - d3));
+    }
+    let cp = ap - ac;
+    let d5 = ab.dot(&cp);
+    let d6 = ac.dot(&cp);
+    if d6 >= 0.0 && d5 <= d6 {
+        return a + ac;
+    }
+    let vb = d5 * d2 - d1 * d6;
+    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
+        return a + ac * (d2 / (d2 - d6));
+    }
+    let va = d3 * d6 - d5 * d4;
+    if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
+        let w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+        return a + ab + (ac - ab) * w;
+    }
+    let denom = 1.0 / (va + vb + vc);
+    a + ab * (vb * denom) + ac * (vc * denom)
+}
+
+/// A triangle is degenerate when twice its area is below this fraction of its longest edge
+/// squared (its corners are collinear to rounding).
+pub const DEGENERATE_REL: f64 = 1e-12;
+
+impl Mesh {
+    /// A mesh from corner triples; `Err(k)` names the first degenerate triangle.
+    pub fn new(triangles: &[[P3; 3]]) -> std::result::Result<Mesh, usize> {
+        let mut tris = Vec::with_capacity(triangles.len());
+        let mut boxes = Vec::with_capacity(triangles.len());
+        for (k, [a, b, c]) in triangles.iter().enumerate() {
+            let (ab, ac) = (b - a, c - a);
+            let cross = ab.cross(&ac);
+            let longest = ab.norm_squared().max(ac.norm_squared()).max((c - b).norm_squared());
+            if cross.norm().is_nan() || cross.norm() <= DEGENERATE_REL * longest {
+                return Err(k);
+            }
+            tris.push(Tri { a: *a, ab, ac, n: cross.normalize() });
+            boxes.push(Aabb::of(&[*a, *b, *c]));
+        }
+        let index = Bvh::build(&boxes);
+        let tris = index.order.iter().map(|&i| tris[i as usize]).collect();
+        Ok(Mesh { tris, index })
+    }
+
+    /// Number of triangles.
+    pub fn len(&self) -> usize {
+        self.tris.len()
+    }
+
+    /// True if there are no triangles.
+    pub fn is_empty(&self) -> bool {
+        self.tris.is_empty()
+    }
+
+    /// A box holding the mesh.
+    pub fn bounds(&self) -> Aabb {
+        self.index.bounds()
+    }
+
+    /// The exact nearest point no farther than `bound`. Where several triangles are equally
+    /// near (an edge or corner), the one facing `q` most is reported, so its normal tells the
+    /// side `q` is on.
+    pub fn nearest(&self, q: &P3, bound: f64) -> Option<MeshFoot> {
+        let bound2 = if bound.is_finite() { bound * bound } else { f64::INFINITY };
+        let mut best: Option<(usize, f64, P3, f64)> = None;
+        self.index.nearest(q, bound2, |k, _| {
+            let t = &self.tris[k];
+            let p = closest_on_triangle(q, t);
+            let e = (q - p).norm_squared();
+            let facing = (q - p).dot(&t.n);
+            let better = match &best {
+                None => true,
+                Some((_, b, _, f)) => {
+                    let tie = (e - b).abs() <= 1e-12 * b.max(1e-12);
+                    if tie { facing > *f } else { e < *b }
+                }
+            };
+            if better && e <= bound2 {
+                best = Some((k, e, p, facing));
+            }
+            e
+        });
+        let (k, _, point, _) = best?;
+        Some(MeshFoot { foot: Foot { point, normal: self.tris[k].n }, triangle: self.index.order[k] as usize })
+    }
+
+    /// Every triangle's corners, in the index's order (for brute-force checks and exports).
+    pub fn corners(&self) -> impl Iterator<Item = [P3; 3]> + '_ {
+        self.tris.iter().map(|t| [t.a, t.a + t.ab, t.a + t.ac])
+    }
+}
+
+/// Reads an STL file (binary or ASCII) into corner triples. Empty, truncated and malformed files
+/// and non-finite coordinates are input errors naming the facet (and its line in ASCII files).
+pub fn read_stl(input: &Input) -> Result<Vec<[P3; 3]>> {
+    let data = &input.data;
+    let here = || Location::file(&input.name);
+    if data.iter().all(|b| b.is_ascii_whitespace()) {
+        return Err(Error::input("empty STL file").at(here()));
+    }
+    let starts_solid = data.len() >= 6 && data[..6].eq_ignore_ascii_case(b"solid ");
+    let binary_count =
+        (data.len() >= 84).then(|| u32::from_le_bytes([data[80], data[81], data[82], data[83]]) as usize);
+    let binary_fits = binary_count.is_some_and(|n| data.len() == 84 + 50 * n);
+    // Binary files whose 80-byte header happens to start with "solid" are common: the size
+    // decides. stl_io probes by the word, so such a header is blanked before it reads.
+    let ascii = starts_solid && !binary_fits;
+    let mut bytes = std::borrow::Cow::Borrowed(data.as_slice());
+    if !ascii {
+        let Some(n) = binary_count else {
+            return Err(
+                Error::input(format!("truncated STL: {} bytes, a binary STL needs at least 84", data.len())).at(here())
+            );
+        };
+        if data.len() < 84 + 50 * n {
+            return Err(Error::input(format!(
+                "truncated binary STL: the header announces {n} triangles ({} bytes) but the file has {} bytes",
+                84 + 50 * n,
+                data.len()
+            ))
+            .at(here()));
+        }
+        if starts_solid {
+            let mut owned = data.clone();
+            owned[..6].copy_from_slice(b"binary");
+            bytes = std::borrow::Cow::Owned(owned);
+        }
+    }
+    let mut cursor = std::io::Cursor::new(bytes.as_ref());
+    let reader =
+        stl_io::create_stl_reader(&mut cursor).map_err(|e| Error::input(format!("not an STL file: {e}")).at(here()))?;
+    let mut out = Vec::with_capacity(binary_count.unwrap_or(0).min(50_000_000));
+    for (k, tri) in reader.enumerate() {
+        let facet_at = |k: usize| {
+            let loc = here().field(format!("facet {}", k + 1));
+            if ascii { loc.line(ascii_facet_line(data, k)) } else { loc }
+        };
+        let tri = tri.map_err(|e| Error::input(format!("malformed STL: {e}")).at(facet_at(k)))?;
+        let corners = tri.vertices.map(|v| P3::new(v[0] as f64, v[1] as f64, v[2] as f64));
+        if !corners.iter().all(|p| p.iter().all(|c| c.is_finite())) {
+            return Err(Error::input("a corner coordinate is not a finite number").at(facet_at(k)));
+        }
+        out.push(corners);
+    }
+    if out.is_empty() {
+        return Err(Error::input("the STL file holds no triangles").at(here()));
+    }
+    Ok(out)
+}
+
+/// 1-based line of the `k`-th (0-based) `facet` keyword of an ASCII STL, or of the last line.
+fn ascii_facet_line(data: &[u8], k: usize) -> u64 {
+    let mut seen = 0;
+    let mut last = 1;
+    for (n, line) in data.split(|&b| b == b'\n').enumerate() {
+        last = n as u64 + 1;
+        let text = String::from_utf8_lossy(line);
+        if text.trim_start().to_ascii_lowercase().starts_with("facet") {
+            if seen == k {
+                return last;
+            }
+            seen += 1;
+        }
+    }
+    last
+}
+
+/// Reads an STL file and builds its mesh; a degenerate triangle is an input error naming it.
+pub fn load_stl(input: &Input) -> Result<Mesh> {
+    let corners = read_stl(input)?;
+    Mesh::new(&corners).map_err(|k| {
+        let [a, b, c] = corners[k];
+        Error::input(format!(
+            "degenerate triangle (zero area): corners ({}, {}, {}), ({}, {}, {}), ({}, {}, {})",
+            a.x, a.y, a.z, b.x, b.y, b.z, c.x, c.y, c.z
+        ))
+        .at(Location::file(&input.name).field(format!("facet {}", k + 1)))
+    })
+}
+
+/// Binary STL bytes of the triangles (normals from the corners' order), for tests and tools.
+pub fn binary_stl(triangles: &[[P3; 3]]) -> Vec<u8> {
+    let mut out = vec![0u8; 80];
+    out[..16].copy_from_slice(b"camkit mesh     ");
+    out.extend_from_slice(&(triangles.len() as u32).to_le_bytes());
+    for [a, b, c] in triangles {
+        let n = (b - a).cross(&(c - a)).try_normalize(0.0).unwrap_or(V3::zeros());
+        for v in [n, a.coords, b.coords, c.coords] {
+            for i in 0..3 {
+                out.extend_from_slice(&(v[i] as f32).to_le_bytes());
+            }
+        }
+        out.extend_from_slice(&[0, 0]);
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn input(name: &str, data: Vec<u8>) -> Input {
+        Input { name: name.into(), data }
+    }
+
+    /// A height field z = f(x, y) as triangles on an n × n grid over [0, 10]².
+    fn field(n: usize) -> Vec<[P3; 3]> {
+        let f = |i: usize, j: usize| {
+            let (x, y) = (i as f64 * 10.0 / n as f64, j as f64 * 10.0 / n as f64);
+            P3::new(x, y, (x * 0.7).sin() + (y * 0.4).cos())
+        };
+        let mut t = Vec::new();
+        for i in 0..n {
+            for j in 0..n {
+                t.push([f(i, j), f(i + 1, j), f(i + 1, j + 1)]);
+                t.push([f(i, j), f(i + 1, j + 1), f(i, j + 1)]);
+            }
+        }
+        t
+    }
+
+    #[test]
+    fn nearest_matches_brute_force() {
+        let tris = field(30);
+        let mesh = Mesh::new(&tris).unwrap();
+        for q in [P3::new(3.1, 4.2, 3.0), P3::new(-2.0, 5.0, 0.0), P3::new(7.7, 9.9, -1.5), P3::new(5.0, 5.0, 0.9)] {
+            let got = mesh.nearest(&q, f64::INFINITY).unwrap();
+            let brute = tris
+                .iter()
+                .map(|[a, b, c]| {
+                    let t = Tri { a: *a, ab: b - a, ac: c - a, n: V3::z() };
+                    (closest_on_triangle(&q, &t) - q).norm()
+                })
+                .fold(f64::INFINITY, f64::min);
+            assert_eq!((got.foot.point - q).norm(), brute);
+            assert!(mesh.nearest(&q, brute * 0.999).is_none());
+        }
+    }
+
+    #[test]
+    fn reads_binary_and_ascii_and_refuses_bad_files() {
+        let tris = field(3);
+        let bin = binary_stl(&tris);
+        assert_eq!(read_stl(&input("a.stl", bin.clone())).unwrap().len(), tris.len());
+        // A binary file whose header starts with "solid " is still binary.
+        let mut solid = bin.clone();
+        solid[..6].copy_from_slice(b"solid ");
+        assert_eq!(read_stl(&input("a.stl", solid)).unwrap().len(), tris.len());
+        let e = read_stl(&input("a.stl", bin[..bin.len() - 7].to_vec())).unwrap_err();
+        assert!(e.to_string().contains("truncated binary STL"), "{e}");
+        assert!(read_stl(&input("e.stl", Vec::new())).unwrap_err().to_string().contains("empty STL"));
+        let ascii = "solid t\nfacet normal 0 0 1\n outer loop\n  vertex 0 0 0\n  vertex 1 0 0\n  vertex 0 1 0\n endloop\nendfacet\n\
+                     facet normal 0 0 1\n outer loop\n  vertex 0 0 0\n  vertex 1 0 x\n";
+        let e = read_stl(&input("t.stl", ascii.as_bytes().to_vec())).unwrap_err();
+        assert!(e.to_string().starts_with("t.stl:9 (facet 2): malformed STL"), "{e}");
+        let flat = vec![[P3::origin(), P3::new(1.0, 0.0, 0.0), P3::new(2.0, 0.0, 0.0)]];
+        let e = load_stl(&input("d.stl", binary_stl(&flat))).unwrap_err();
+        assert!(e.to_string().starts_with("d.stl (facet 1): degenerate triangle"), "{e}");
+    }
+}
