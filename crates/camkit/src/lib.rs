@@ -7,12 +7,14 @@
 //! [`report`]), and SVG plots ([`svg`]). Nothing here is specific to one filter.
 
 pub mod cli;
+pub mod contour;
 pub mod doc;
 pub mod error;
 pub mod gcode;
 pub mod geom;
 pub mod io;
 pub mod json;
+pub mod kinematics;
 pub mod model;
 pub mod num;
 pub mod report;

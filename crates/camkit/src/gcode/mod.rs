@@ -3,10 +3,12 @@
 //! interpret (M, S, T words, other G codes) is kept, in order, as an opaque block that a filter
 //! writes back verbatim.
 
+mod axes;
 mod read;
 mod table;
 mod write;
 
+pub use axes::{AXIS_LETTERS, AxisMove, AxisProgram, read_axes};
 pub use read::{Decimals, read};
 pub use table::{program_to_table, table_to_program};
 pub use write::{OutMove, Writer};
