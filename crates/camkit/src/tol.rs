@@ -23,6 +23,14 @@ pub const ROUNDOFF_REL: f64 = 1e-9;
 /// Absolute slack (mm) for round-off in distance checks at the scale of a machine (≤ 10 m).
 pub const ROUNDOFF_ABS: f64 = 1e-9;
 
+/// Largest accepted error (mm) of a verified offset: every output point lies within this of the
+/// offset distance from the input, none closer than the distance minus this.
+pub const OFFSET_TOL: f64 = 1e-6;
+
+/// Repeated points and collinear runs within this (mm) are merged when an offset retries on a
+/// cleaned input; the result is still verified against the original.
+pub const CLEAN_EPS: f64 = 1e-9;
+
 /// `a` and `b` differ by at most `eps`.
 pub fn near(a: f64, b: f64, eps: f64) -> bool {
     (a - b).abs() <= eps

@@ -116,6 +116,175 @@ pub fn unit2(v: &V2) -> Option<V2> {
     (n > 0.0).then(|| v / n)
 }
 
+/// Angles at which the circle `(c, r)` meets the infinite line through `p` with direction `u`
+/// (any length): none, one (tangent) or two.
+fn circle_line_angles(c: &P2, r: f64, p: &P2, u: &V2) -> ([f64; 2], usize) {
+    let len = u.norm();
+    if len == 0.0 {
+        return ([0.0; 2], 0);
+    }
+    let u = u / len;
+    let n = V2::new(-u.y, u.x);
+    // Signed distance of the centre from the line, and the foot of the centre on it.
+    let h = n.dot(&(c - p));
+    if h.abs() > r {
+        return ([0.0; 2], 0);
+    }
+    let foot = c - n * h;
+    let half = (r * r - h * h).max(0.0).sqrt();
+    let a = angle_of(&(foot + u * half - c));
+    let b = angle_of(&(foot - u * half - c));
+    ([a, b], if half == 0.0 { 1 } else { 2 })
+}
+
+/// Largest distance from a point of `arc` to the segment `[a, b]` (one-sided Hausdorff distance
+/// from the arc to the segment), exactly: the distance along the arc is smooth between the
+/// angles where the arc crosses the perpendiculars at `a` and `b`, and on each piece its
+/// extremes lie where the arc is parallel to the segment or points at `a` or `b`.
+pub fn arc_segment_max(arc: &Arc2, a: &P2, b: &P2) -> f64 {
+    let d = b - a;
+    let mut angles: Vec<f64> = vec![arc.start, arc.start + arc.sweep];
+    if d.norm_squared() > 0.0 {
+        let n = V2::new(-d.y, d.x);
+        angles.push(angle_of(&n));
+        angles.push(angle_of(&-n));
+        for e in [a, b] {
+            let (hits, k) = circle_line_angles(&arc.c, arc.r, e, &n);
+            angles.extend_from_slice(&hits[..k]);
+        }
+    }
+    for e in [a, b] {
+        if (e - arc.c).norm_squared() > 0.0 {
+            angles.push(angle_of(&(e - arc.c)));
+            angles.push(angle_of(&(arc.c - e)));
+        }
+    }
+    angles
+        .into_iter()
+        .filter(|&phi| arc.spans(phi) || phi == arc.start + arc.sweep)
+        .map(|phi| point_segment(&arc.point_at(phi), a, b))
+        .fold(0.0, f64::max)
+}
+
+/// Largest distance from a point of arc `from` to arc `to` (one-sided Hausdorff distance),
+/// exactly: candidates are the ends of `from`, its crossings of the rays through the ends of
+/// `to` and of the bisector of those ends, and the stationary points of the distance to the
+/// centre and to each end of `to`.
+pub fn arc_arc_max(from: &Arc2, to: &Arc2) -> f64 {
+    let e0 = to.start_point();
+    let e1 = to.end_point();
+    let mut angles: Vec<f64> = vec![from.start, from.start + from.sweep];
+    let dc = to.c - from.c;
+    if dc.norm_squared() > 0.0 {
+        angles.push(angle_of(&dc));
+        angles.push(angle_of(&-dc));
+    }
+    for e in [&e0, &e1] {
+        let v = e - from.c;
+        if v.norm_squared() > 0.0 {
+            angles.push(angle_of(&v));
+            angles.push(angle_of(&-v));
+        }
+        let (hits, k) = circle_line_angles(&from.c, from.r, &to.c, &(e - to.c));
+        angles.extend_from_slice(&hits[..k]);
+    }
+    let g = e1 - e0;
+    if g.norm_squared() > 0.0 {
+        let m = P2::from((e0.coords + e1.coords) * 0.5);
+        let (hits, k) = circle_line_angles(&from.c, from.r, &m, &V2::new(-g.y, g.x));
+        angles.extend_from_slice(&hits[..k]);
+    }
+    angles
+        .into_iter()
+        .filter(|&phi| from.spans(phi) || phi == from.start + from.sweep)
+        .map(|phi| point_arc(&from.point_at(phi), to))
+        .fold(0.0, f64::max)
+}
+
+/// Smallest distance between the segments `[a, b]` and `[c, d]` (0 if they meet).
+pub fn segment_segment_min(a: &P2, b: &P2, c: &P2, d: &P2) -> f64 {
+    let (u, v, w) = (b - a, d - c, c - a);
+    let den = cross2(&u, &v);
+    if den != 0.0 {
+        let t = cross2(&w, &v) / den;
+        let s = cross2(&w, &u) / den;
+        if (0.0..=1.0).contains(&t) && (0.0..=1.0).contains(&s) {
+            return 0.0;
+        }
+    }
+    point_segment(a, c, d).min(point_segment(b, c, d)).min(point_segment(c, a, b)).min(point_segment(d, a, b))
+}
+
+/// Smallest distance between the segment `[a, b]` and `arc` (0 if they meet): crossings, the
+/// ends of each against the other, and the arc points where the arc is parallel to the segment.
+pub fn segment_arc_min(a: &P2, b: &P2, arc: &Arc2) -> f64 {
+    let d = b - a;
+    let len2 = d.norm_squared();
+    if len2 > 0.0 {
+        let (hits, k) = circle_line_angles(&arc.c, arc.r, a, &d);
+        for &phi in &hits[..k] {
+            let t = (arc.point_at(phi) - a).dot(&d) / len2;
+            if (0.0..=1.0).contains(&t) && arc.spans(phi) {
+                return 0.0;
+            }
+        }
+    }
+    let mut best = point_arc(a, arc).min(point_arc(b, arc));
+    best = best.min(point_segment(&arc.start_point(), a, b)).min(point_segment(&arc.end_point(), a, b));
+    if len2 > 0.0 {
+        let n = V2::new(-d.y, d.x);
+        for phi in [angle_of(&n), angle_of(&-n)] {
+            if arc.spans(phi) {
+                best = best.min(point_segment(&arc.point_at(phi), a, b));
+            }
+        }
+    }
+    best
+}
+
+/// Smallest distance between two arcs (0 if they meet): crossings, the ends of each against the
+/// other, and the pairs of points on the line through both centres.
+pub fn arc_arc_min(p: &Arc2, q: &Arc2) -> f64 {
+    let dc = q.c - p.c;
+    let dist = dc.norm();
+    if dist > 0.0 {
+        // Circle-circle crossings.
+        let a = (p.r * p.r - q.r * q.r + dist * dist) / (2.0 * dist);
+        let h2 = p.r * p.r - a * a;
+        if h2 >= 0.0 {
+            let u = dc / dist;
+            let n = V2::new(-u.y, u.x);
+            let base = p.c + u * a;
+            let h = h2.sqrt();
+            for x in [base + n * h, base - n * h] {
+                if p.spans(angle_of(&(x - p.c))) && q.spans(angle_of(&(x - q.c))) {
+                    return 0.0;
+                }
+            }
+        }
+    }
+    let mut best = point_arc(&p.start_point(), q).min(point_arc(&p.end_point(), q));
+    best = best.min(point_arc(&q.start_point(), p)).min(point_arc(&q.end_point(), p));
+    if dist > 0.0 {
+        let u = dc / dist;
+        for sp in [1.0, -1.0] {
+            let phi = angle_of(&(u * sp));
+            if !p.spans(phi) {
+                continue;
+            }
+            for sq in [1.0, -1.0] {
+                let psi = angle_of(&(u * sq));
+                if q.spans(psi) {
+                    best = best.min((p.point_at(phi) - q.point_at(psi)).norm());
+                }
+            }
+        }
+    } else if p.spans(q.start) || q.spans(p.start) {
+        best = best.min((p.r - q.r).abs());
+    }
+    best
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -169,6 +338,57 @@ mod tests {
             // distance by at most its sagitta (< 1e-6 here).
             prop_assert!(sampled <= exact + 1e-6, "sampled {sampled} > exact {exact}");
             prop_assert!(exact - sampled < 0.02 * (b - a).norm() + 1e-6, "exact {exact} sampled {sampled}");
+        }
+    }
+
+    /// Brute force for the new pair distances: dense samples of both pieces.
+    fn samples_arc(arc: &Arc2, n: usize) -> Vec<P2> {
+        (0..=n).map(|i| arc.point_at_fraction(i as f64 / n as f64)).collect()
+    }
+
+    fn samples_seg(a: &P2, b: &P2, n: usize) -> Vec<P2> {
+        (0..=n).map(|i| a + (b - a) * (i as f64 / n as f64)).collect()
+    }
+
+    proptest! {
+        #[test]
+        fn pair_distances_match_brute_force(
+            ax in -3.0..3.0f64, ay in -3.0..3.0f64, bx in -3.0..3.0f64, by in -3.0..3.0f64,
+            cx in -1.0..1.0f64, cy in -1.0..1.0f64,
+            s1 in -PI..PI, w1 in -6.0..6.0f64, r1 in 0.5..2.0f64,
+            s2 in -PI..PI, w2 in -6.0..6.0f64, r2 in 0.5..2.0f64,
+        ) {
+            prop_assume!(w1.abs() > 0.05 && w2.abs() > 0.05);
+            let p = Arc2 { c: P2::origin(), r: r1, start: s1, sweep: w1 };
+            let q = Arc2 { c: P2::new(cx, cy), r: r2, start: s2, sweep: w2 };
+            let (a, b) = (P2::new(ax, ay), P2::new(bx, by));
+            let (pa, qa, sa) = (samples_arc(&p, 3000), samples_arc(&q, 3000), samples_seg(&a, &b, 3000));
+            // Sampling overestimates a minimum by at most half a sample spacing plus a sagitta.
+            let slack = 0.01;
+            let m = arc_arc_min(&p, &q);
+            let bm = pa.iter().map(|u| point_arc(u, &q)).chain(qa.iter().map(|u| point_arc(u, &p))).fold(f64::INFINITY, f64::min);
+            prop_assert!(m <= bm + 1e-9 && bm - m < slack, "arc_arc_min {m} brute {bm}");
+            let m = segment_arc_min(&a, &b, &p);
+            let bm = sa.iter().map(|u| point_arc(u, &p)).fold(f64::INFINITY, f64::min);
+            prop_assert!(m <= bm + 1e-9 && bm - m < slack, "segment_arc_min {m} brute {bm}");
+            // One-sided maxima: sampled points of `from`, exact distance to `to`.
+            let mx = arc_arc_max(&p, &q);
+            let bx = pa.iter().map(|u| point_arc(u, &q)).fold(0.0, f64::max);
+            prop_assert!(mx >= bx - 1e-9 && mx - bx < slack, "arc_arc_max {mx} brute {bx}");
+            let mx = arc_segment_max(&p, &a, &b);
+            let bx = pa.iter().map(|u| point_segment(u, &a, &b)).fold(0.0, f64::max);
+            prop_assert!(mx >= bx - 1e-9 && mx - bx < slack, "arc_segment_max {mx} brute {bx}");
+        }
+
+        #[test]
+        fn segment_segment_min_matches_brute_force(
+            ax in -3.0..3.0f64, ay in -3.0..3.0f64, bx in -3.0..3.0f64, by in -3.0..3.0f64,
+            cx in -3.0..3.0f64, cy in -3.0..3.0f64, dx in -3.0..3.0f64, dy in -3.0..3.0f64,
+        ) {
+            let (a, b, c, d) = (P2::new(ax, ay), P2::new(bx, by), P2::new(cx, cy), P2::new(dx, dy));
+            let m = segment_segment_min(&a, &b, &c, &d);
+            let bm = samples_seg(&a, &b, 3000).iter().map(|u| point_segment(u, &c, &d)).fold(f64::INFINITY, f64::min);
+            prop_assert!(m <= bm + 1e-9 && bm - m < 0.01, "{m} vs {bm}");
         }
     }
 }

@@ -1,0 +1,251 @@
+//! Verified offsets on top of `cavalier_contours`: its validity epsilons are chosen from the
+//! input's scale, every result is verified ([`super::verify`]), and a rejected result is retried
+//! with other epsilons and then on a cleaned input (repeated points and collinear runs merged)
+//! before the offset gives up with the defect it found. Nothing unverified is returned.
+
+use super::Contour;
+use super::region::Region;
+use super::verify::{Check, Defect, SegSet, verify};
+use crate::tol;
+use cavalier_contours::polyline::{PlineOffsetOptions, PlineSource, Polyline, TouchingLoopBehavior};
+use cavalier_contours::shape_algorithms::{Shape, ShapeOffsetOptions};
+use std::fmt;
+
+/// Which side of the direction of travel an offset lies on.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Side {
+    /// Left of travel (G41; the paper's −1).
+    Left,
+    /// Right of travel (G42; the paper's +1).
+    Right,
+}
+
+impl Side {
+    /// +1 for left, −1 for right: the sign of a left-positive offset.
+    pub fn sign(self) -> f64 {
+        match self {
+            Side::Left => 1.0,
+            Side::Right => -1.0,
+        }
+    }
+
+    /// The side of paper 004's sign: +1 right, −1 left.
+    pub fn from_paper(sign: i32) -> Option<Side> {
+        match sign {
+            1 => Some(Side::Right),
+            -1 => Some(Side::Left),
+            _ => None,
+        }
+    }
+}
+
+/// Settings of a verified offset.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct OffsetOptions {
+    /// Largest accepted deviation of an output point's distance from the offset distance (mm).
+    pub tol: f64,
+    /// The input may cross itself (cavalier's self-intersection handling is switched on).
+    pub self_crossing_input: bool,
+}
+
+impl Default for OffsetOptions {
+    fn default() -> Self {
+        OffsetOptions { tol: tol::OFFSET_TOL, self_crossing_input: false }
+    }
+}
+
+/// A verified offset.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Offset {
+    /// The offset contours (closed loops for closed input; possibly none).
+    pub contours: Vec<Contour>,
+    /// What the verification measured.
+    pub check: Check,
+    /// Kernel runs until one passed (1 when the first did).
+    pub attempts: usize,
+    /// True if the passing run needed the cleaned input.
+    pub cleaned: bool,
+}
+
+/// An offset that no attempt could make valid.
+#[derive(Clone, Debug, PartialEq)]
+pub struct OffsetError {
+    /// Kernel runs tried.
+    pub attempts: usize,
+    /// What was wrong with the last result.
+    pub defect: Defect,
+}
+
+impl fmt::Display for OffsetError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "no verified offset after {} attempts: {}", self.attempts, self.defect.describe())
+    }
+}
+
+impl std::error::Error for OffsetError {}
+
+/// Epsilons of one kernel run: (equal positions, offset distance validity).
+type Eps = (f64, f64);
+
+/// The epsilons to try, the first from the input's scale: well below its shortest piece, well
+/// above round-off at its size.
+fn ladder(contours: &[&Contour]) -> Vec<Eps> {
+    let (mut size, mut shortest) = (1.0f64, f64::INFINITY);
+    for c in contours {
+        if let Some((lo, hi)) = c.bounds() {
+            size = size.max((hi - lo).abs().max()).max(lo.coords.abs().max()).max(hi.coords.abs().max());
+        }
+        for s in c.segs() {
+            let l = s.length();
+            if l > 0.0 {
+                shortest = shortest.min(l);
+            }
+        }
+    }
+    let pos = (shortest * 1e-4).clamp(size * 1e-12, 1e-5);
+    let scaled = (pos, (pos * 10.0).min(1e-6).max(pos));
+    let mut out = vec![scaled];
+    for e in [(1e-5, 1e-4), (1e-8, 1e-6), (1e-6, 1e-5), (1e-9, 1e-8), (1e-7, 1e-7)] {
+        if !out.contains(&e) {
+            out.push(e);
+        }
+    }
+    out
+}
+
+/// `c` with repeated points and collinear runs merged (positions within `eps`).
+fn cleaned(c: &Contour, eps: f64) -> Contour {
+    let p = c.to_pline();
+    let p = p.remove_repeat_pos(eps).unwrap_or(p);
+    let p = p.remove_redundant(eps).unwrap_or(p);
+    Contour::from_pline(&p)
+}
+
+/// Runs `kernel` over the epsilon ladder on the input, then on the cleaned input, returning the
+/// first result that verifies against the original input.
+fn verified(
+    input: &[&Contour],
+    d: f64,
+    side: f64,
+    closed: bool,
+    opts: &OffsetOptions,
+    kernel: impl Fn(&[Contour], Eps) -> Vec<Contour>,
+) -> Result<Offset, OffsetError> {
+    verified_from(input, input, d, side, closed, opts, kernel)
+}
+
+/// As [`verified`], but the kernel offsets `source` (loops already offset from `input`) while
+/// the result is verified against `input` at distance `d`.
+fn verified_from(
+    source: &[&Contour],
+    input: &[&Contour],
+    d: f64,
+    side: f64,
+    closed: bool,
+    opts: &OffsetOptions,
+    kernel: impl Fn(&[Contour], Eps) -> Vec<Contour>,
+) -> Result<Offset, OffsetError> {
+    let set = SegSet::new(input.iter().copied());
+    let original: Vec<Contour> = source.iter().map(|c| (*c).clone()).collect();
+    let tidy: Vec<Contour> = source.iter().map(|c| cleaned(c, tol::CLEAN_EPS)).collect();
+    let mut attempts = 0;
+    let mut defect = None;
+    let scale = ladder(source);
+    for (loops, was_cleaned) in [(&original, false), (&tidy, true)] {
+        if was_cleaned && tidy == original {
+            continue;
+        }
+        for &eps in &scale {
+            attempts += 1;
+            let out = kernel(loops, eps);
+            match verify(&set, &out, d, side, closed, opts.tol) {
+                Ok(check) => return Ok(Offset { contours: out, check, attempts, cleaned: was_cleaned }),
+                Err(e) => defect = Some(e),
+            }
+        }
+    }
+    Err(OffsetError { attempts, defect: defect.expect("at least one attempt") })
+}
+
+/// Offsets one contour by `d` (mm, > 0) to `side`, verified. The offset of an open contour is
+/// open pieces; of a closed one, closed loops.
+pub fn offset_contour(c: &Contour, d: f64, side: Side, opts: &OffsetOptions) -> Result<Offset, OffsetError> {
+    let signed = d * side.sign();
+    verified(&[c], d, side.sign(), c.closed, opts, |source, (pos, dist)| {
+        let pline: Polyline<f64> = source[0].to_pline();
+        let o = PlineOffsetOptions {
+            handle_self_intersects: opts.self_crossing_input,
+            pos_equal_eps: pos,
+            offset_dist_eps: dist,
+            touching_loop_behavior: TouchingLoopBehavior::Separate,
+            ..Default::default()
+        };
+        pline.parallel_offset_opt(signed, &o).iter().map(Contour::from_pline).collect()
+    })
+}
+
+/// Offsets a region inward (into the material to remove) by `d` (mm, > 0), verified: closed loops,
+/// counter-clockwise around what remains and clockwise around islands.
+pub fn offset_region(region: &Region, d: f64, opts: &OffsetOptions) -> Result<Offset, OffsetError> {
+    let loops = region.loops();
+    verified(&loops, d, 1.0, true, opts, |source, (pos, dist)| shape_offset(source, d, (pos, dist)))
+}
+
+/// Offsets `loops` (a region already offset from `input`'s loops, oriented as a region) inward by
+/// `rel` more, verified against `input` at the total distance `total`.
+pub fn offset_region_further(
+    loops: &[&Contour],
+    rel: f64,
+    input: &Region,
+    total: f64,
+    opts: &OffsetOptions,
+) -> Result<Offset, OffsetError> {
+    verified_from(loops, &input.loops(), total, 1.0, true, opts, |source, eps| shape_offset(source, rel, eps))
+}
+
+/// True if `loops` (oriented as a region) still have something left after an inward offset by
+/// `d`, by one unverified kernel run at the input's own epsilons (a probe, not a result).
+pub fn region_survives(loops: &[&Contour], d: f64) -> bool {
+    let owned: Vec<Contour> = loops.iter().map(|c| (*c).clone()).collect();
+    !shape_offset(&owned, d, ladder(loops)[0]).is_empty()
+}
+
+/// One run of cavalier's shape offset on loops oriented as a region (outer counter-clockwise,
+/// islands clockwise).
+pub(crate) fn shape_offset(loops: &[Contour], d: f64, (pos, dist): Eps) -> Vec<Contour> {
+    let shape = Shape::from_plines(loops.iter().map(Contour::to_pline));
+    let o = ShapeOffsetOptions { pos_equal_eps: pos, offset_dist_eps: dist, slice_join_eps: dist.max(pos) };
+    let out = shape.parallel_offset(d, &o);
+    out.ccw_plines.iter().chain(&out.cw_plines).map(|p| Contour::from_pline(&p.polyline)).collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geom::P2;
+    use std::f64::consts::PI;
+
+    #[test]
+    fn circle_offsets_match_closed_forms() {
+        let c = Contour::circle(P2::new(3.0, -1.0), 10.0, 0.3, true);
+        let inside = offset_contour(&c, 2.5, Side::Left, &OffsetOptions::default()).unwrap();
+        assert_eq!(inside.contours.len(), 1);
+        assert!((inside.contours[0].area() - PI * 7.5 * 7.5).abs() < 1e-9);
+        assert!(inside.check.deviation() < 1e-9, "{:?}", inside.check);
+        let outside = offset_contour(&c, 2.5, Side::Right, &OffsetOptions::default()).unwrap();
+        assert!((outside.contours[0].area() - PI * 12.5 * 12.5).abs() < 1e-9);
+        let gone = offset_contour(&c, 10.5, Side::Left, &OffsetOptions::default()).unwrap();
+        assert!(gone.contours.is_empty());
+    }
+
+    #[test]
+    fn rectangle_outward_has_rounded_corners() {
+        let r =
+            Contour::polygon(&[P2::new(0.0, 0.0), P2::new(40.0, 0.0), P2::new(40.0, 20.0), P2::new(0.0, 20.0)], true);
+        let o = offset_contour(&r, 3.0, Side::Right, &OffsetOptions::default()).unwrap();
+        let area = 40.0 * 20.0 + 2.0 * 3.0 * (40.0 + 20.0) + PI * 9.0;
+        assert!((o.contours[0].area() - area).abs() < 1e-9, "{} vs {area}", o.contours[0].area());
+        let i = offset_contour(&r, 3.0, Side::Left, &OffsetOptions::default()).unwrap();
+        assert!((i.contours[0].area() - 34.0 * 14.0).abs() < 1e-9);
+    }
+}

@@ -1,0 +1,313 @@
+//! Contour-parallel pocketing: a region's verified offsets at the tool radius and every step
+//! beyond it, as separate passes in machining order.
+//!
+//! Passes of one region form a tree: each connected piece of the material left at one offset
+//! (a counter-clockwise loop with the clockwise loops of the islands in it) lies inside exactly
+//! one piece of the offset before it. Passes are written depth first, deepest pieces first,
+//! siblings nearest first, so each sub-pocket is cleared from its centre out to its wall and the
+//! wall pass comes last; each loop starts at its vertex nearest the end of the pass before.
+//! With [`Passes::UntilEmpty`] a piece whose centre the last pass does not reach (material deeper
+//! than the tool radius inside it) gets one clean-up pass as deep as the piece allows.
+
+use super::Contour;
+use super::offset::{OffsetError, OffsetOptions, offset_region, offset_region_further, region_survives};
+use super::region::Region;
+use super::verify::Check;
+use crate::geom::P2;
+use rayon::prelude::*;
+
+/// How many passes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Passes {
+    /// This many offsets (fewer where the region runs out).
+    Count(usize),
+    /// Until nothing is left, with a clean-up pass where the centre would stay uncut.
+    UntilEmpty,
+}
+
+/// Cutting direction, for a spindle turning clockwise (M3).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Direction {
+    /// Material on the right of travel: boundaries counter-clockwise, islands clockwise.
+    Climb,
+    /// The reverse.
+    Conventional,
+}
+
+/// Settings of a pocket.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PocketOptions {
+    /// Tool radius (mm): the first pass's offset.
+    pub radius: f64,
+    /// Step over between passes (mm).
+    pub step: f64,
+    /// How many passes.
+    pub passes: Passes,
+    /// Cutting direction.
+    pub direction: Direction,
+    /// Verification settings.
+    pub offset: OffsetOptions,
+}
+
+/// One pass: a closed loop of the tool centre.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Pass {
+    /// The loop, started and directed for machining.
+    pub contour: Contour,
+    /// Its offset from the region's contours (mm).
+    pub distance: f64,
+    /// 0 for the wall pass, counting inward; clean-up passes count one beyond their piece.
+    pub level: usize,
+    /// Index of the region.
+    pub region: usize,
+    /// True for a loop around an island.
+    pub island: bool,
+    /// True for a clean-up pass.
+    pub clean_up: bool,
+}
+
+/// A pocket's passes and the proof of them.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Pocket {
+    /// Passes in machining order.
+    pub passes: Vec<Pass>,
+    /// The worst verification figures over every pass.
+    pub check: Check,
+    /// Kernel runs (more than one per offset when a run had to be retried).
+    pub attempts: usize,
+    /// Offsets whose passing run needed the cleaned input.
+    pub cleaned: usize,
+    /// Clean-up passes added.
+    pub clean_ups: usize,
+}
+
+/// An offset of a pocket that could not be verified.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PocketError {
+    /// Index of the region.
+    pub region: usize,
+    /// Offset distance (mm).
+    pub distance: f64,
+    /// What went wrong.
+    pub error: OffsetError,
+}
+
+/// One connected piece of material left at one offset level.
+struct Piece {
+    outer: Contour,
+    islands: Vec<Contour>,
+    level: usize,
+    distance: f64,
+    children: Vec<usize>,
+    /// A clean-up pass: its distance and loops.
+    clean_up: Option<(f64, Vec<Contour>)>,
+}
+
+/// Groups one level's loops into pieces: each clockwise loop joins the smallest
+/// counter-clockwise loop around it.
+fn pieces_of(loops: Vec<Contour>, level: usize, distance: f64) -> Vec<Piece> {
+    let (outer, inner): (Vec<Contour>, Vec<Contour>) = loops.into_iter().partition(|c| c.is_ccw());
+    let mut out: Vec<Piece> = outer
+        .into_iter()
+        .map(|outer| Piece { outer, islands: Vec::new(), level, distance, children: Vec::new(), clean_up: None })
+        .collect();
+    for c in inner {
+        let probe = c.probe_point().unwrap_or(P2::origin());
+        let host = (0..out.len())
+            .filter(|&k| out[k].outer.winding_number(&probe) != 0)
+            .min_by(|&a, &b| out[a].outer.area().total_cmp(&out[b].outer.area()));
+        if let Some(k) = host {
+            out[k].islands.push(c);
+        }
+    }
+    out
+}
+
+/// Machining-order passes of `regions`.
+pub fn pocket(regions: &[Region], opts: &PocketOptions) -> Result<Pocket, PocketError> {
+    let mut result = Pocket::default();
+    let mut cursor: Option<P2> = None;
+    for (ri, region) in regions.iter().enumerate() {
+        let levels = match opts.passes {
+            Passes::Count(n) => n,
+            Passes::UntilEmpty => {
+                let (lo, hi) = region.outer.bounds().expect("a region has a boundary");
+                let half = 0.5 * (hi - lo).min();
+                ((half - opts.radius) / opts.step).floor().max(0.0) as usize + 2
+            }
+        };
+        let distances: Vec<f64> = (0..levels).map(|k| opts.radius + k as f64 * opts.step).collect();
+        let offsets: Vec<Result<super::Offset, PocketError>> = distances
+            .par_iter()
+            .map(|&d| {
+                offset_region(region, d, &opts.offset).map_err(|error| PocketError { region: ri, distance: d, error })
+            })
+            .collect();
+        let mut pieces: Vec<Piece> = Vec::new();
+        let mut previous: Vec<usize> = Vec::new();
+        for (k, o) in offsets.into_iter().enumerate() {
+            let o = o?;
+            result.attempts += o.attempts;
+            result.cleaned += usize::from(o.cleaned);
+            if o.contours.is_empty() {
+                break;
+            }
+            result.check = result.check.merge(&o.check);
+            let mut current = Vec::new();
+            for piece in pieces_of(o.contours, k, distances[k]) {
+                let probe = piece.outer.probe_point().unwrap_or(P2::origin());
+                let parent = previous.iter().copied().find(|&p| pieces[p].outer.winding_number(&probe) != 0);
+                let id = pieces.len();
+                if let Some(p) = parent {
+                    pieces[p].children.push(id);
+                }
+                current.push(id);
+                pieces.push(piece);
+            }
+            previous = current;
+        }
+        if opts.passes == Passes::UntilEmpty && opts.step <= 2.0 * opts.radius {
+            add_clean_ups(&mut pieces, region, ri, opts, &mut result)?;
+        }
+        let roots: Vec<usize> = (0..pieces.len()).filter(|&i| pieces[i].level == 0).collect();
+        emit(&pieces, &roots, ri, opts.direction, &mut cursor, &mut result.passes);
+    }
+    Ok(result)
+}
+
+/// A clean-up pass found for a piece: its index, distance and offset.
+type CleanUp = (usize, f64, super::Offset);
+
+/// Gives each leaf piece whose centre lies deeper than the tool radius below its loops a
+/// clean-up pass at the deepest offset it still has (found by bisection, then verified).
+fn add_clean_ups(
+    pieces: &mut [Piece],
+    region: &Region,
+    ri: usize,
+    opts: &PocketOptions,
+    result: &mut Pocket,
+) -> Result<(), PocketError> {
+    let leaves: Vec<usize> = (0..pieces.len()).filter(|&i| pieces[i].children.is_empty()).collect();
+    let found: Vec<Result<Option<CleanUp>, PocketError>> = leaves
+        .par_iter()
+        .map(|&i| {
+            let p = &pieces[i];
+            let loops: Vec<&Contour> = std::iter::once(&p.outer).chain(&p.islands).collect();
+            if !region_survives(&loops, opts.radius) {
+                return Ok(None);
+            }
+            let (mut lo, mut hi) = (opts.radius, opts.step.max(opts.radius));
+            if region_survives(&loops, hi) {
+                // The next level was empty for the whole region but not here: go deeper.
+                hi = 2.0 * opts.radius;
+                if region_survives(&loops, hi) {
+                    return Ok(None);
+                }
+            }
+            for _ in 0..12 {
+                let mid = 0.5 * (lo + hi);
+                if region_survives(&loops, mid) { lo = mid } else { hi = mid }
+            }
+            let total = p.distance + lo;
+            offset_region_further(&loops, lo, region, total, &opts.offset)
+                .map(|o| (!o.contours.is_empty()).then_some((i, total, o)))
+                .map_err(|error| PocketError { region: ri, distance: total, error })
+        })
+        .collect();
+    for f in found {
+        if let Some((i, total, o)) = f? {
+            result.attempts += o.attempts;
+            result.check = result.check.merge(&o.check);
+            result.clean_ups += 1;
+            pieces[i].clean_up = Some((total, o.contours));
+        }
+    }
+    Ok(())
+}
+
+/// Writes the passes of the pieces `ids` and everything inside them, deepest first.
+fn emit(pieces: &[Piece], ids: &[usize], ri: usize, dir: Direction, cursor: &mut Option<P2>, out: &mut Vec<Pass>) {
+    let mut left: Vec<usize> = ids.to_vec();
+    while !left.is_empty() {
+        let k = nearest(cursor, left.iter().map(|&i| &pieces[i].outer));
+        let id = left.remove(k);
+        let p = &pieces[id];
+        emit(pieces, &p.children, ri, dir, cursor, out);
+        if let Some((distance, extra)) = &p.clean_up {
+            let distance = *distance;
+            for c in extra {
+                push(
+                    out,
+                    cursor,
+                    c,
+                    dir,
+                    Pass {
+                        contour: Contour::default(),
+                        distance,
+                        level: p.level + 1,
+                        region: ri,
+                        island: !c.is_ccw(),
+                        clean_up: true,
+                    },
+                );
+            }
+        }
+        let mut islands: Vec<&Contour> = p.islands.iter().collect();
+        while !islands.is_empty() {
+            let k = nearest(cursor, islands.iter().copied());
+            let c = islands.remove(k);
+            push(
+                out,
+                cursor,
+                c,
+                dir,
+                Pass {
+                    contour: Contour::default(),
+                    distance: p.distance,
+                    level: p.level,
+                    region: ri,
+                    island: true,
+                    clean_up: false,
+                },
+            );
+        }
+        push(
+            out,
+            cursor,
+            &p.outer,
+            dir,
+            Pass {
+                contour: Contour::default(),
+                distance: p.distance,
+                level: p.level,
+                region: ri,
+                island: false,
+                clean_up: false,
+            },
+        );
+    }
+}
+
+/// Index of the contour with a vertex nearest `cursor` (the first when there is no cursor).
+fn nearest<'a>(cursor: &Option<P2>, contours: impl Iterator<Item = &'a Contour>) -> usize {
+    let Some(at) = cursor else { return 0 };
+    contours
+        .map(|c| c.vertices.iter().map(|v| (v.p - at).norm_squared()).fold(f64::INFINITY, f64::min))
+        .enumerate()
+        .min_by(|a, b| a.1.total_cmp(&b.1))
+        .map_or(0, |(i, _)| i)
+}
+
+/// Appends a pass of `c`, directed and started at its vertex nearest the cursor.
+fn push(out: &mut Vec<Pass>, cursor: &mut Option<P2>, c: &Contour, dir: Direction, mut pass: Pass) {
+    let c = if dir == Direction::Conventional { c.reversed() } else { c.clone() };
+    let start = match cursor {
+        Some(at) => (0..c.vertices.len())
+            .min_by(|&a, &b| (c.vertices[a].p - *at).norm_squared().total_cmp(&(c.vertices[b].p - *at).norm_squared()))
+            .unwrap_or(0),
+        None => 0,
+    };
+    pass.contour = c.rotated(start);
+    *cursor = pass.contour.vertices.first().map(|v| v.p);
+    out.push(pass);
+}
