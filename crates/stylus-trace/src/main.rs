@@ -1,0 +1,327 @@
+//! `stylus-trace`: copy-simulation CL data on a defined model.
+
+use camkit::cli::{self, IoArgs, Progress};
+use camkit::error::{Error, Location, Result};
+use camkit::geom::P3;
+use camkit::io::{Input, Output, write_atomic};
+use camkit::model::Model;
+use camkit::report::Report;
+use camkit::table::{self, Col, WriteOptions};
+use clap::{Parser, ValueEnum};
+use std::path::PathBuf;
+use std::time::Instant;
+use stylus_trace::curve::{Steps, Stylus};
+use stylus_trace::scan::Scan;
+use stylus_trace::two_surface::TwoSurface;
+use stylus_trace::{Mode, Options, Region, output};
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+enum ModeArg {
+    /// Scanning lines: vertical motion planes along --angle, --pick apart.
+    Scan,
+    /// Contour lines: motion plane z = const at each level.
+    Contour,
+    /// Two-surface contact: the stylus touches --surfaces A and B at once.
+    TwoSurface,
+}
+
+#[derive(Parser, Debug)]
+#[command(
+    name = "stylus-trace",
+    version,
+    allow_negative_numbers = true,
+    about = "Copy simulation: a virtual stylus traces a defined model and yields CL data with no offset surface.",
+    long_about = "Copy simulation (paper 000 §3.1-3.2): a virtual stylus, a sphere of radius r, traces a defined \
+model (a model JSON document or an STL file). L runs from the nearest point of the whole model to the stylus centre; \
+ΔR = (r − |L|)·L/|L| is corrected inside the motion plane until |ΔR| ≤ --contact-tol, then the stylus steps on, \
+each step as long as keeps the chord within --chord-tol of the true CL curve. Every CL point is measured again \
+against the whole model before anything is written: no point is closer than r − --contact-tol to any part of it.",
+    after_help = after_help()
+)]
+struct Args {
+    #[command(flatten)]
+    io: IoArgs,
+    /// Mode.
+    #[arg(long, value_enum, default_value_t = ModeArg::Scan)]
+    mode: ModeArg,
+    /// Stylus radius r (mm).
+    #[arg(short = 'r', long, value_name = "MM")]
+    radius: f64,
+    /// Region in XY as X0,X1,Y0,Y1 (mm); default: the model's bounding box.
+    #[arg(long, value_name = "X0,X1,Y0,Y1", allow_hyphen_values = true)]
+    region: Option<String>,
+    /// Scan direction, degrees from +x towards +y.
+    #[arg(long, default_value_t = 0.0, value_name = "DEG")]
+    angle: f64,
+    /// Pick feed between scan lines (mm).
+    #[arg(long, default_value_t = 1.0, value_name = "MM")]
+    pick: f64,
+    /// Scan alternate lines in opposite directions (default one-way).
+    #[arg(long)]
+    zigzag: bool,
+    /// Contour levels: heights of the stylus centre, Z1,Z2,... (mm).
+    #[arg(long, value_name = "Z,..", allow_hyphen_values = true)]
+    levels: Option<String>,
+    /// Contour levels every MM from the top of the model down (centre heights).
+    #[arg(long, value_name = "MM")]
+    z_step: Option<f64>,
+    /// Two-surface mode: surfaces A,B by name or index (default: the model's two surfaces).
+    #[arg(long, value_name = "A,B")]
+    surfaces: Option<String>,
+    /// Two-surface mode: a stylus centre X,Y,Z near the concave line to start from.
+    #[arg(long, value_name = "X,Y,Z", allow_hyphen_values = true)]
+    start: Option<String>,
+    /// Trace contours and the concave line the other way round.
+    #[arg(long)]
+    reverse: bool,
+    /// Largest distance between a chord of consecutive CL points and the true CL curve (mm).
+    #[arg(long, default_value_t = 0.001, value_name = "MM")]
+    chord_tol: f64,
+    /// Contact tolerance: largest |ΔR| left at a CL point (mm).
+    #[arg(long, default_value_t = 1e-4, value_name = "MM")]
+    contact_tol: f64,
+    /// Longest step between CL points (mm).
+    #[arg(long, default_value_t = 2.0, value_name = "MM")]
+    max_step: f64,
+    /// Shortest step (mm): where the stylus cannot go on with it, the run fails.
+    #[arg(long, default_value_t = 1e-4, value_name = "MM")]
+    min_step: f64,
+    /// Fixed decimals for positions (default: exact shortest round-trip numbers).
+    #[arg(long, value_name = "N")]
+    decimals: Option<u32>,
+    /// Write an SVG (top view) of the traced lines.
+    #[arg(long, value_name = "FILE")]
+    svg: Option<PathBuf>,
+    /// Worker threads (default: all cores); the output is the same for any number.
+    #[arg(long, value_name = "N")]
+    threads: Option<usize>,
+}
+
+fn after_help() -> String {
+    let mut s =
+        String::from("Input: a model JSON document (docs/formats.md, `model`) or an STL file (binary or ASCII).\n\n");
+    s.push_str(&table::columns::help_text(
+        &[],
+        &[Col::Path, Col::X, Col::Y, Col::Z, Col::Px, Col::Py, Col::Pz, Col::Nx, Col::Ny, Col::Nz, Col::Tag],
+    ));
+    s.push_str("  surface                   name of the model surface touched\n");
+    s.push_str("two-surface mode adds p2x,p2y,p2z n2x,n2y,n2z surface2 (second contact) and bx,by,bz (bisector).\n");
+    s.push_str("x,y,z is the stylus centre; nx,ny,nz is L/|L|, from the contact towards the centre.\n");
+    s.push_str("\nExit status: 0 done, 1 a check failed (no convergence, |ΔR| over tolerance), 2 bad input or usage.");
+    s
+}
+
+fn main() -> std::process::ExitCode {
+    cli::run("stylus-trace", || run(Args::parse()))
+}
+
+fn usage(message: impl Into<String>) -> Error {
+    Error::input(message)
+}
+
+/// Comma-separated finite numbers, exactly `n` of them when `n` is given.
+fn numbers(text: &str, what: &str, n: Option<usize>) -> Result<Vec<f64>> {
+    let v: Vec<f64> = text
+        .split(',')
+        .map(|t| t.trim().parse::<f64>().ok().filter(|x| x.is_finite()))
+        .collect::<Option<_>>()
+        .ok_or_else(|| usage(format!("{what} must be comma-separated numbers, got {text:?}")))?;
+    if n.is_some_and(|n| v.len() != n) || v.is_empty() {
+        return Err(usage(format!("{what} needs {} numbers, got {text:?}", n.unwrap_or(1))));
+    }
+    Ok(v)
+}
+
+fn positive(v: f64, what: &str) -> Result<f64> {
+    if v.is_finite() && v > 0.0 { Ok(v) } else { Err(usage(format!("{what} must be a positive number, got {v}"))) }
+}
+
+fn region(args: &Args, model: &Model) -> Result<Region> {
+    if let Some(text) = &args.region {
+        let v = numbers(text, "--region", Some(4))?;
+        if !(v[0] < v[1] && v[2] < v[3]) {
+            return Err(usage("--region must be X0,X1,Y0,Y1 with X0 < X1 and Y0 < Y1"));
+        }
+        return Ok(Region { x0: v[0], x1: v[1], y0: v[2], y1: v[3] });
+    }
+    let b = model.bounds();
+    if !b.is_bounded() {
+        return Err(usage("the model is unbounded (a plane or an endless cylinder): give --region X0,X1,Y0,Y1"));
+    }
+    Ok(Region { x0: b.min.x, x1: b.max.x, y0: b.min.y, y1: b.max.y })
+}
+
+fn options(args: &Args, model: &Model, input: &Input) -> Result<Options> {
+    let radius = positive(args.radius, "--radius")?;
+    let stylus = Stylus { radius, contact_tol: positive(args.contact_tol, "--contact-tol")? };
+    let steps = Steps {
+        chord_tol: positive(args.chord_tol, "--chord-tol")?,
+        max_step: positive(args.max_step, "--max-step")?,
+        min_step: positive(args.min_step, "--min-step")?,
+    };
+    if steps.min_step >= steps.max_step {
+        return Err(usage("--min-step must be below --max-step"));
+    }
+    let region = region(args, model)?;
+    let b = model.bounds();
+    let misses = || {
+        Error::input(format!(
+            "the region x {}..{}, y {}..{} misses the model (x {}..{}, y {}..{})",
+            region.x0, region.x1, region.y0, region.y1, b.min.x, b.max.x, b.min.y, b.max.y
+        ))
+        .at(Location::file(&input.name))
+    };
+    if b.is_bounded()
+        && !(region.x0 <= b.max.x + radius
+            && region.x1 >= b.min.x - radius
+            && region.y0 <= b.max.y + radius
+            && region.y1 >= b.min.y - radius)
+    {
+        return Err(misses());
+    }
+    let mode = match args.mode {
+        ModeArg::Scan => Mode::Scan(Scan {
+            region,
+            angle: if args.angle.is_finite() { args.angle } else { return Err(usage("--angle must be a number")) },
+            pick: positive(args.pick, "--pick")?,
+            zigzag: args.zigzag,
+        }),
+        ModeArg::Contour => {
+            let levels = match (&args.levels, args.z_step) {
+                (Some(text), None) => numbers(text, "--levels", None)?,
+                (None, Some(dz)) => {
+                    let dz = positive(dz, "--z-step")?;
+                    if !b.is_bounded() {
+                        return Err(usage("--z-step needs a bounded model: give --levels"));
+                    }
+                    // From just below the top of the centre's range down to the model's bottom.
+                    let top = b.max.z + radius;
+                    let n = ((b.max.z - b.min.z) / dz).floor() as usize;
+                    (1..=n + 1).map(|k| top - k as f64 * dz).filter(|z| *z >= b.min.z).collect()
+                }
+                (Some(_), Some(_)) => return Err(usage("give either --levels or --z-step, not both")),
+                (None, None) => return Err(usage("contour mode needs --levels Z1,Z2,.. or --z-step MM")),
+            };
+            if levels.is_empty() {
+                return Err(usage("no contour level lies within the model's height"));
+            }
+            Mode::Contour { region, levels }
+        }
+        ModeArg::TwoSurface => {
+            let surfaces = match &args.surfaces {
+                Some(text) => {
+                    let names: Vec<&str> = text.split(',').map(str::trim).collect();
+                    if names.len() != 2 {
+                        return Err(usage(format!("--surfaces needs two surfaces A,B, got {text:?}")));
+                    }
+                    let find = |n: &str| {
+                        model.surface_index(n).ok_or_else(|| {
+                            let known: Vec<&str> = model.surfaces.iter().map(|s| s.name.as_str()).collect();
+                            usage(format!("--surfaces: no surface {n:?} in the model (it has {})", known.join(", ")))
+                        })
+                    };
+                    [find(names[0])?, find(names[1])?]
+                }
+                None if model.surfaces.len() == 2 => [0, 1],
+                None => {
+                    return Err(usage("two-surface mode needs --surfaces A,B (the model has more or fewer than two)"));
+                }
+            };
+            if surfaces[0] == surfaces[1] {
+                return Err(usage("--surfaces must name two different surfaces"));
+            }
+            let start = match &args.start {
+                Some(text) => {
+                    let v = numbers(text, "--start", Some(3))?;
+                    Some(P3::new(v[0], v[1], v[2]))
+                }
+                None => None,
+            };
+            Mode::TwoSurface(TwoSurface { surfaces, start, reverse: args.reverse, region })
+        }
+    };
+    Ok(Options { stylus, steps, mode })
+}
+
+fn run(args: Args) -> Result<()> {
+    if let Some(n) = args.threads {
+        if n == 0 {
+            return Err(usage("--threads must be at least 1"));
+        }
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(n)
+            .build_global()
+            .map_err(|e| Error::runtime(format!("cannot start {n} threads: {e}")))?;
+    }
+    if args.decimals.is_some_and(|d| d > 12) {
+        return Err(usage("--decimals must be at most 12"));
+    }
+    let started = Instant::now();
+    let input = Input::open(&args.io.input)?;
+    let model = Model::load(&input)?;
+    let loaded = started.elapsed().as_secs_f64();
+    let opts = options(&args, &model, &input)?;
+    let progress = Progress::new(opts.mode.units() as u64, opts.mode.tag());
+    let traced_at = Instant::now();
+    let paths = stylus_trace::trace(&model, &opts, &|| progress.inc(1))
+        .map_err(|f| Error::check(format!("the stylus stopped at ({}, {}, {}): {}", f.at.x, f.at.y, f.at.z, f.what)))?;
+    progress.finish();
+    let trace_seconds = traced_at.elapsed().as_secs_f64();
+    if paths.is_empty() {
+        return Err(Error::input(
+            "the stylus touched the model nowhere in the region: the scan region misses the model",
+        )
+        .at(Location::file(&input.name)));
+    }
+    let two = match &opts.mode {
+        Mode::TwoSurface(ts) => Some(ts.surfaces),
+        _ => None,
+    };
+    let verified = stylus_trace::verify(&model, &opts.stylus, &paths, two).map_err(|rej| {
+        Error::check(format!("CL point in row {} (line {} of the output): {}", rej.row + 1, rej.row + 2, rej.what))
+    })?;
+    let tag = opts.mode.tag();
+    let t = output::table(&model, &paths, tag, two.is_some());
+    let mut out = Output::new(args.io.output.as_deref());
+    table::write(&mut out, &t, &WriteOptions { decimals: args.decimals })?;
+    let seconds = started.elapsed().as_secs_f64();
+    if let Some(path) = &args.svg {
+        let title = format!(
+            "{}: {} mode, r = {} mm, {} passes, {} CL points",
+            input.name,
+            tag,
+            opts.stylus.radius,
+            paths.len(),
+            verified.points
+        );
+        write_atomic(path, output::plot(&paths, &title).to_svg(1000.0).as_bytes())?;
+    }
+    if let Some(path) = &args.io.report {
+        let iterations: Vec<u32> = paths.iter().flat_map(|p| p.points.iter().map(|q| q.iterations)).collect();
+        let mut r = Report::new("stylus-trace");
+        r.set("mode", tag)
+            .set("radius_mm", opts.stylus.radius)
+            .set("contact_tol_mm", opts.stylus.contact_tol)
+            .set("chord_tol_mm", opts.steps.chord_tol)
+            .set("surfaces", model.surfaces.len())
+            .set("triangles", model.triangles())
+            .set("units", opts.mode.units())
+            .set("paths", paths.len())
+            .set("points", verified.points)
+            .set(
+                "newton_iterations_mean",
+                iterations.iter().map(|&i| i as f64).sum::<f64>() / iterations.len().max(1) as f64,
+            )
+            .set("newton_iterations_max", iterations.iter().copied().max().unwrap_or(0))
+            .set("largest_residual_mm", verified.largest_residual)
+            .set("min_clearance_mm", verified.min_clearance)
+            .set("largest_chord_deviation_mm", paths.iter().map(|p| p.deviation).fold(0.0, f64::max))
+            .set("load_seconds", loaded)
+            .set("trace_seconds", trace_seconds)
+            .set("seconds", seconds)
+            .set("points_per_second", verified.points as f64 / trace_seconds.max(1e-9))
+            .set("threads", rayon::current_num_threads());
+        r.write(path)?;
+    }
+    out.commit()
+}
