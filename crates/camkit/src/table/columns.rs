@@ -94,6 +94,17 @@ pub const COLUMNS: &[ColumnSpec] = &[
     typed!(Ny, "ny", "unit vector", "empty", "unit surface normal, y"),
     typed!(Nz, "nz", "unit vector", "empty", "unit surface normal, z"),
     typed!(Tag, "tag", "text", "empty", "free label (trochoid, contour, probe, ...)"),
+    named!("surface", "text", "empty", "stylus-trace: name of the model surface the contact point lies on"),
+    named!("p2x", "mm", "empty", "stylus-trace two-surface mode: contact point on the second surface, x"),
+    named!("p2y", "mm", "empty", "second contact point, y"),
+    named!("p2z", "mm", "empty", "second contact point, z"),
+    named!("n2x", "unit vector", "empty", "unit normal at the second contact (towards the stylus centre), x"),
+    named!("n2y", "unit vector", "empty", "second contact normal, y"),
+    named!("n2z", "unit vector", "empty", "second contact normal, z"),
+    named!("surface2", "text", "empty", "name of the model surface of the second contact"),
+    named!("bx", "unit vector", "empty", "bisector of both contact normals (basic tool axis, paper 000 fig. 10), x"),
+    named!("by", "unit vector", "empty", "bisector, y"),
+    named!("bz", "unit vector", "empty", "bisector, z"),
 ];
 
 /// The spec of a typed column.
