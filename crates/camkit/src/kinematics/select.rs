@@ -119,7 +119,9 @@ impl Solver<'_> {
             if !ok {
                 continue;
             }
-            let cost: f64 = (0..n).map(|k| (out[k] - prev[k]).abs()).sum();
+            // Ties go to the branch whose secondary angle is not negative (paper 002 eq. 3's).
+            let cost: f64 =
+                (0..n).map(|k| (out[k] - prev[k]).abs()).sum::<f64>() + if n == 2 && out[1] < 0.0 { 1e-9 } else { 0.0 };
             if best.as_ref().is_none_or(|(c, _)| cost < *c - 1e-12) {
                 best = Some((cost, Choice { rot: out, branch: b, singular: false }));
             }

@@ -1,0 +1,218 @@
+//! `post-6axis`: inverse kinematics and NC output for 3-, 4-, 5- and 6-axis machines (papers 002
+//! §4.1–4.3 and 000 §3.2), with a read-back check of every program it writes.
+//!
+//! CL rows (tool tip, tool axis, spindle orientation, feed) become machine poses through the
+//! machine's chain ([`camkit::kinematics`]), blocks are inserted until the controller's linear
+//! interpolation stays within tolerance ([`plan`]), the program is written in the machine's
+//! dialect ([`nc`]), and read back through the forward kinematics to measure what it really does
+//! ([`readback`]).
+
+pub mod nc;
+pub mod plan;
+pub mod readback;
+
+use camkit::doc::machine::Machine;
+use camkit::error::{Error, Location, Result};
+use camkit::gcode::read_axes;
+use camkit::kinematics::{Chain, Solver};
+use camkit::table::{Col, Move, Table};
+use plan::{Cl, SpindleSetup};
+
+/// What the user asks of one run.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Settings {
+    /// Largest tip deviation (mm) between blocks.
+    pub tol: f64,
+    /// Largest axis deviation (degrees) between blocks.
+    pub angle_tol: f64,
+    /// Largest spindle-orientation error (degrees).
+    pub spindle_tol: f64,
+    /// Radius (mm) turning a rotary move into path length for inverse-time feed.
+    pub rotary_radius: f64,
+    /// Feed (mm/min) for rows without one.
+    pub feed: Option<f64>,
+}
+
+impl Default for Settings {
+    fn default() -> Self {
+        Settings { tol: 0.005, angle_tol: 0.05, spindle_tol: 0.5, rotary_radius: 10.0, feed: None }
+    }
+}
+
+/// CL rows from a toolpath table, checked: no arcs, a tool axis on multi-axis machines, unit
+/// axes (normalised when within 1e-3 of unit, counted in the second value), a feed for every
+/// cutting row, spindle orientations only for a machine that can command them.
+pub fn cl_rows(
+    table: &Table,
+    file: &str,
+    chain: &Chain,
+    machine: &Machine,
+    feed: Option<f64>,
+) -> Result<(Vec<Cl>, usize)> {
+    let at = |line: u64, field: &str| Location::file(file).line(line).field(field);
+    if !chain.rotaries().is_empty() && !table.schema.has(Col::I) {
+        return Err(Error::input("missing columns i, j, k: a multi-axis machine needs the tool axis of every row")
+            .at(Location::file(file).line(1)));
+    }
+    if table.schema.has(Col::S) && machine.spindle.is_none() {
+        return Err(Error::input(
+            "the rows carry spindle orientations (column s) but the machine document has no `spindle` to command them",
+        )
+        .at(Location::file(file).line(1).field("s")));
+    }
+    let mut out = Vec::with_capacity(table.rows.len());
+    let mut normalised = 0;
+    let mut prev_path = None;
+    for row in &table.rows {
+        if row.mv.is_arc() {
+            return Err(
+                Error::input("arcs (cw/ccw) are not posted: give the toolpath as lines").at(at(row.line, "move"))
+            );
+        }
+        let n = row.axis.norm();
+        if !n.is_finite() || (n - 1.0).abs() > camkit::tol::UNIT_VECTOR_SLACK {
+            return Err(Error::input(format!("the tool axis has length {n}, not 1")).at(at(row.line, "i,j,k")));
+        }
+        if (n - 1.0).abs() > UNIT_EXACT {
+            normalised += 1;
+        }
+        let rapid = row.mv == Move::Rapid || prev_path != Some(row.path);
+        prev_path = Some(row.path);
+        let f = row.f.or(feed);
+        if let Some(v) = f
+            && v <= 0.0
+        {
+            return Err(Error::input(format!("feed must be positive, got {v}")).at(at(row.line, "f")));
+        }
+        if f.is_none() && !rapid {
+            return Err(Error::input("no feed for this move: give the f column or --feed").at(at(row.line, "f")));
+        }
+        out.push(Cl { tip: row.pos, axis: row.axis / n, s: row.s, feed: f, rapid, line: row.line });
+    }
+    if out.is_empty() {
+        return Err(Error::input("no rows: nothing to post").at(Location::file(file)));
+    }
+    Ok((out, normalised))
+}
+
+/// The planning view of a machine.
+pub fn planning<'a>(machine: &Machine, chain: &'a Chain) -> plan::Machine<'a> {
+    plan::Machine {
+        solver: Solver { chain, policy: machine.policy(), cone: machine.singular_cone.to_radians() },
+        travel: [machine.travel.x, machine.travel.y, machine.travel.z],
+        spindle: machine.spindle.as_ref().map(|s| SpindleSetup {
+            offset: s.offset,
+            sense: s.sense,
+            interpolated: s.mode == camkit::doc::machine::SpindleMode::Axis,
+        }),
+    }
+}
+
+/// Everything one run of the post produced.
+#[derive(Clone, Debug)]
+pub struct Posted {
+    /// The program text.
+    pub text: Vec<u8>,
+    /// Planning figures.
+    pub plan: plan::Stats,
+    /// Writing figures.
+    pub written: nc::Written,
+    /// The program read back and compared with the rows.
+    pub check: readback::Deviation,
+    /// Tolerance (mm) linearisation worked to: `tol` less the rounding of the written numbers.
+    pub tol_used: f64,
+}
+
+/// Largest tip error (mm) that rounding the written numbers can add: linear decimals in 3-D and
+/// the rotary decimals at the largest lever arm of the rows.
+fn rounding_allowance(rows: &[Cl], chain: &Chain, machine: &Machine) -> f64 {
+    let d = machine.program.decimals;
+    let unit = if machine.program.units == camkit::doc::machine::UnitsDoc::Inch { 25.4 } else { 1.0 };
+    let lin = 0.5 * 10f64.powi(-(d.linear as i32)) * unit * 3f64.sqrt();
+    let offsets: f64 =
+        chain.links().iter().map(|l| if let camkit::kinematics::Link::Offset(v) = l { v.norm() } else { 0.0 }).sum();
+    let reach =
+        rows.iter().map(|r| (r.tip.coords - chain.frame()).norm()).fold(0.0, f64::max) + chain.frame().norm() + offsets;
+    let rot = 0.5 * 10f64.powi(-(d.rotary as i32));
+    lin + rot.to_radians() * reach * chain.rotaries().len() as f64
+}
+
+/// A tool axis whose length differs from 1 by more than this was not written as a unit vector
+/// (beyond the round-off of its text): it is normalised with a warning.
+pub const UNIT_EXACT: f64 = 1e-9;
+
+/// Fraction of `--spindle-tol` that planning works to.
+pub const SPINDLE_MARGIN: f64 = 0.8;
+
+/// Samples per block in the read-back check.
+pub const CHECK_SAMPLES: usize = 8;
+
+/// Plans, writes and reads back the program for CL rows.
+pub fn post(
+    rows: &[Cl],
+    file: &str,
+    machine: &Machine,
+    chain: &Chain,
+    s: &Settings,
+    comments: Vec<String>,
+) -> Result<Posted> {
+    let allowance = rounding_allowance(rows, chain, machine);
+    let tol_used = s.tol - allowance;
+    if tol_used < s.tol / 4.0 {
+        return Err(Error::input(format!(
+            "--tol {} mm is too small for the program's decimals (rounding alone may move the tip {allowance:.6} mm): \
+             raise --tol or program.decimals",
+            s.tol
+        )));
+    }
+    let opts = plan::Options {
+        tol: tol_used,
+        angle_tol: s.angle_tol.to_radians(),
+        // The check measures the spindle against the CL at the tip's nearest point, planning at the
+        // block's own parameter: keep a margin between the two.
+        spindle_tol: s.spindle_tol * SPINDLE_MARGIN,
+        tcp: machine.program.tcp,
+        interpolate_singular: machine.singular == camkit::doc::machine::SingularRule::Interpolate,
+    };
+    let m = planning(machine, chain);
+    let (steps, stats) = plan::plan(rows, &m, &opts).map_err(|e| {
+        let loc = Location::file(file).line(rows[e.row].line).field("i,j,k");
+        if e.unreachable { Error::input(e.message).at(loc) } else { Error::check(e.message).at(loc) }
+    })?;
+    let wopts = nc::WriteOptions { rotary_radius: s.rotary_radius, comments };
+    let (text, written) = nc::write(&steps, machine, chain, &wopts).map_err(|nc::NoFeed(row)| {
+        Error::input("no feed for this move: give the f column or --feed")
+            .at(Location::file(file).line(rows[row].line).field("f"))
+    })?;
+    let check = check_text(&text, rows, machine, chain)?;
+    let axis_bound = s.angle_tol + stats.pose_axis_error.to_degrees() * 2.0;
+    if !camkit::tol::within(check.tip, s.tol) || !camkit::tol::within(check.coverage, s.tol) {
+        return Err(Error::check(format!(
+            "read back, the program deviates {:.6} mm from the CL (at NC line {}; rows {:.6} mm): more than --tol {} mm",
+            check.tip, check.tip_line, check.coverage, s.tol
+        )));
+    }
+    if check.axis_deg > axis_bound * (1.0 + 1e-6) + 1e-9 {
+        return Err(Error::check(format!(
+            "read back, the tool axis deviates {:.5}° from the CL (NC line {}): more than --angle-tol {}°",
+            check.axis_deg, check.axis_line, s.angle_tol
+        )));
+    }
+    if machine.spindle.is_some() && check.spindle_deg > s.spindle_tol * (1.0 + 1e-6) + 1e-9 {
+        return Err(Error::check(format!(
+            "read back, the spindle orientation deviates {:.4}° from the CL: more than --spindle-tol {}°",
+            check.spindle_deg, s.spindle_tol
+        )));
+    }
+    Ok(Posted { text, plan: stats, written, check, tol_used })
+}
+
+/// Reads a program text back and compares it with the rows.
+pub fn check_text(text: &[u8], rows: &[Cl], machine: &Machine, chain: &Chain) -> Result<readback::Deviation> {
+    let text = std::str::from_utf8(text).map_err(|_| Error::runtime("the written program is not UTF-8"))?;
+    let program = read_axes("written program", text)
+        .map_err(|e| Error::runtime(format!("the written program does not read back: {e}")))?;
+    let reading = readback::Reading::new(machine, chain);
+    let poses = readback::poses(&program, &reading);
+    Ok(readback::verify(rows, &poses, &reading, CHECK_SAMPLES, 1.0))
+}

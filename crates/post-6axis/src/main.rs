@@ -1,0 +1,207 @@
+//! `post-6axis`: CL rows to NC for a machine described in JSON, checked by reading the NC back.
+
+use camkit::cli::{self, IoArgs};
+use camkit::doc::Frame;
+use camkit::doc::machine::Machine;
+use camkit::error::{Error, Location, Result};
+use camkit::gcode::read_axes;
+use camkit::io::{Input, Output};
+use camkit::kinematics::Chain;
+use camkit::report::Report;
+use camkit::table::{self, Col, WriteOptions};
+use clap::Parser;
+use post_6axis::{Settings, cl_rows, post, readback};
+use std::process::ExitCode;
+use std::time::Instant;
+
+#[derive(Parser, Debug)]
+#[command(
+    name = "post-6axis",
+    version,
+    allow_negative_numbers = true,
+    about = "Post-process CL rows (tool tip, tool axis, spindle orientation) into NC for a 3-, 5- or 6-axis machine.",
+    long_about = "Post-process CL rows (tool tip x,y,z, tool axis i,j,k, spindle orientation s, feed f) into NC \
+for the machine described by --machine (papers 002 §4 and 000 §3.2). Each row's pose is solved by inverse \
+kinematics (both branches; the one inside the limits nearest the previous pose), blocks are inserted until \
+the controller's linear interpolation keeps the tip within --tol of the straight CL segment and the axis \
+within --angle-tol, and the written program is read back through the forward kinematics before it is \
+delivered: a program that fails the check is not written. --verify compares an existing program with the \
+rows; --reverse turns a program back into the toolpath table.",
+    after_help = after_help()
+)]
+struct Args {
+    #[command(flatten)]
+    io: IoArgs,
+    /// The machine document (JSON): chain, limits, spindle, dialect.
+    #[arg(long, short = 'm', value_name = "FILE")]
+    machine: String,
+    /// The workpiece frame document (JSON, `xc, yc, za`), e.g. from surf-probe-fit; overrides the
+    /// machine document's `frame`.
+    #[arg(long, value_name = "FILE")]
+    frame: Option<String>,
+    /// Largest distance (mm) of the interpolated tool tip from the straight CL segment.
+    #[arg(long, default_value_t = 0.005, value_name = "MM")]
+    tol: f64,
+    /// Largest angle (degrees) of the interpolated tool axis from the CL axis.
+    #[arg(long, default_value_t = 0.05, value_name = "DEG")]
+    angle_tol: f64,
+    /// Largest error (degrees) of the spindle orientation of a non-rotating tool.
+    #[arg(long, default_value_t = 0.5, value_name = "DEG")]
+    spindle_tol: f64,
+    /// Feed (mm/min) for rows without an f value.
+    #[arg(long, value_name = "MM/MIN")]
+    feed: Option<f64>,
+    /// Radius (mm) at which a rotary move counts as path length for inverse-time feed.
+    #[arg(long, default_value_t = 10.0, value_name = "MM")]
+    rotary_radius: f64,
+    /// Compare the program FILE with the CL rows of INPUT: largest tip, axis and spindle
+    /// deviations, written as JSON on standard output. Exit 1 if beyond the tolerances.
+    #[arg(long, value_name = "NC", conflicts_with = "reverse")]
+    verify: Option<String>,
+    /// INPUT is an NC program: write it back as the toolpath table.
+    #[arg(long)]
+    reverse: bool,
+}
+
+fn after_help() -> String {
+    let mut s = table::columns::help_text(
+        &[Col::Path, Col::Move, Col::X, Col::Y, Col::Z, Col::I, Col::J, Col::K, Col::S, Col::F],
+        &[Col::Path, Col::Move, Col::X, Col::Y, Col::Z, Col::I, Col::J, Col::K, Col::S, Col::F],
+    );
+    s.push_str("(--reverse writes the table; otherwise the output is NC.)\n\n");
+    s.push_str("Machine document: docs/formats.md#post-6axis; examples in data/post-6axis/.\n");
+    s.push_str(
+        "\nExit status: 0 done, 1 the read-back check failed, 2 bad input (a pose outside the limits included).",
+    );
+    s
+}
+
+fn main() -> ExitCode {
+    cli::run("post-6axis", || run(Args::parse()))
+}
+
+fn positive(v: f64, what: &str) -> Result<f64> {
+    if v.is_finite() && v > 0.0 {
+        Ok(v)
+    } else {
+        Err(Error::input(format!("{what} must be a positive number, got {v}")))
+    }
+}
+
+fn load_machine(args: &Args) -> Result<(Machine, Chain)> {
+    let (machine, mut chain) = Machine::read(&args.machine)?;
+    if let Some(path) = &args.frame {
+        let frame = Frame::read(path)?;
+        chain = chain.with_frame(frame.offset());
+    }
+    Ok((machine, chain))
+}
+
+fn run(args: Args) -> Result<()> {
+    let started = Instant::now();
+    let settings = Settings {
+        tol: positive(args.tol, "--tol")?,
+        angle_tol: positive(args.angle_tol, "--angle-tol")?,
+        spindle_tol: positive(args.spindle_tol, "--spindle-tol")?,
+        rotary_radius: positive(args.rotary_radius, "--rotary-radius")?,
+        feed: args.feed.map(|f| positive(f, "--feed")).transpose()?,
+    };
+    let (machine, chain) = load_machine(&args)?;
+    let input = Input::open(&args.io.input)?;
+    let mut out = Output::new(args.io.output.as_deref());
+    let mut report = Report::new("post-6axis");
+    report
+        .set("machine", &machine.name)
+        .set("family", chain.family().name())
+        .set("dialect", format!("{:?}", machine.dialect).to_lowercase());
+    if args.reverse {
+        let text = input.text()?;
+        let program = read_axes(&input.name, text)?;
+        let reading = readback::Reading::new(&machine, &chain);
+        let poses = readback::poses(&program, &reading);
+        let t = readback::reverse(&poses, &reading);
+        if t.rows.is_empty() {
+            return Err(Error::input("no motion blocks in the program").at(Location::file(&input.name)));
+        }
+        report.set("blocks", program.moves.len()).set("rows", t.rows.len());
+        table::write(&mut out, &t, &WriteOptions::default())?;
+        return finish(out, &args, report);
+    }
+    let t = table::read(&input, &[Col::X, Col::Y])?;
+    let (rows, normalised) = cl_rows(&t, &input.name, &chain, &machine, settings.feed)?;
+    if normalised > 0 {
+        cli::warn(&format!("{normalised} tool axes were not unit vectors (within 1e-3): normalised"));
+    }
+    if let Some(nc) = &args.verify {
+        let nc_input = Input::open(nc)?;
+        let program = read_axes(&nc_input.name, nc_input.text()?)?;
+        let reading = readback::Reading::new(&machine, &chain);
+        let poses = readback::poses(&program, &reading);
+        let d = readback::verify(&rows, &poses, &reading, 32, 1.0);
+        deviation_keys(&mut report, &d);
+        report.set("rows", rows.len()).set("tol_mm", settings.tol).set("angle_tol_deg", settings.angle_tol);
+        out.buf = report.to_json().into_bytes();
+        let ok = camkit::tol::within(d.tip, settings.tol) && camkit::tol::within(d.coverage, settings.tol);
+        finish(out, &args, report)?;
+        if !ok {
+            return Err(Error::check(format!(
+                "{nc}: the program deviates {:.6} mm from the CL (NC line {}), rows {:.6} mm from the program: more than --tol {}",
+                d.tip, d.tip_line, d.coverage, settings.tol
+            )));
+        }
+        return Ok(());
+    }
+    let comments = vec![
+        format!("post-6axis {}: {}", env!("CARGO_PKG_VERSION"), machine.name),
+        format!("{} machine, {} rows from {}", chain.family().name(), rows.len(), input.name),
+        format!("tolerance {} mm, {} deg", settings.tol, settings.angle_tol),
+    ];
+    let posted = post(&rows, &input.name, &machine, &chain, &settings, comments)?;
+    out.buf = posted.text;
+    if posted.plan.singular_rows > 0 {
+        cli::warn(&format!(
+            "{} rows lie within {}° of the primary rotary axis: its angle was {} there (largest axis error {:.4}°)",
+            posted.plan.singular_rows,
+            machine.singular_cone,
+            if machine.singular == camkit::doc::machine::SingularRule::Interpolate { "interpolated" } else { "held" },
+            posted.plan.pose_axis_error.to_degrees()
+        ));
+    }
+    let seconds = started.elapsed().as_secs_f64();
+    report
+        .set("rows", rows.len())
+        .set("normalised_axes", normalised)
+        .set("blocks", posted.written.blocks)
+        .set("inserted_blocks", posted.plan.inserted)
+        .set("inverse_time_blocks", posted.written.inverse_time_blocks)
+        .set("spindle_orients", posted.written.orients)
+        .set("dropped_blocks", posted.written.dropped)
+        .set("singular_rows", posted.plan.singular_rows)
+        .set("singular_rule", format!("{:?}", machine.singular).to_lowercase())
+        .set("singular_axis_error_deg", posted.plan.pose_axis_error.to_degrees())
+        .set("unwinds", posted.plan.unwinds)
+        .set("tol_mm", settings.tol)
+        .set("tol_used_mm", posted.tol_used)
+        .set("angle_tol_deg", settings.angle_tol);
+    deviation_keys(&mut report, &posted.check);
+    report.set("seconds", seconds).set("rows_per_second", rows.len() as f64 / seconds.max(1e-9));
+    finish(out, &args, report)
+}
+
+fn deviation_keys(report: &mut Report, d: &readback::Deviation) {
+    report
+        .set("largest_tip_deviation_mm", d.tip)
+        .set("largest_tip_deviation_line", d.tip_line)
+        .set("largest_row_distance_mm", d.coverage)
+        .set("largest_axis_deviation_deg", d.axis_deg)
+        .set("largest_spindle_deviation_deg", d.spindle_deg)
+        .set("blocks_checked", d.blocks)
+        .set("points_checked", d.samples);
+}
+
+fn finish(out: Output, args: &Args, report: Report) -> Result<()> {
+    if let Some(path) = &args.io.report {
+        report.write(path)?;
+    }
+    out.commit()
+}

@@ -1,0 +1,470 @@
+//! From CL rows to machine blocks: a pose per row (inverse kinematics, the solution inside the
+//! limits nearest the previous pose, the primary axis held or interpolated near the singularity,
+//! wrapping axes unwound between passes), then blocks inserted until the controller's linear
+//! interpolation of every axis keeps the tool tip within `tol` of the straight CL segment and the
+//! tool axis within `angle_tol` of the great-circle arc between the end axes.
+
+use camkit::geom::{P3, V3};
+use camkit::kinematics::{Chain, Joints, Solver, principal_deg};
+
+/// One CL row as the post needs it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Cl {
+    /// Tool tip in the workpiece frame (mm).
+    pub tip: P3,
+    /// Unit tool axis.
+    pub axis: V3,
+    /// Spindle orientation of a non-rotating tool (degrees), if commanded.
+    pub s: Option<f64>,
+    /// Feed (mm/min).
+    pub feed: Option<f64>,
+    /// The row starts a pass (rapid, or a new `path`): reached by G0.
+    pub rapid: bool,
+    /// Source line, for messages.
+    pub line: u64,
+}
+
+/// How the spindle orientation is commanded, for planning.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SpindleSetup {
+    /// Controller angle at which the edge faces the tool frame's +X.
+    pub offset: f64,
+    /// +1 or −1.
+    pub sense: f64,
+    /// Interpolated with the other axes (true) or set stepwise by M19 before each block (false).
+    pub interpolated: bool,
+}
+
+/// Planning options.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Options {
+    /// Largest distance (mm) of the interpolated tool tip from the straight CL segment.
+    pub tol: f64,
+    /// Largest angle (radians) of the interpolated tool axis from the arc between the end axes.
+    pub angle_tol: f64,
+    /// Largest error (degrees) of the spindle orientation between blocks.
+    pub spindle_tol: f64,
+    /// Tool-centre-point mode: the control interpolates the tip itself.
+    pub tcp: bool,
+    /// Interpolate the primary axis through singular runs (else hold it).
+    pub interpolate_singular: bool,
+}
+
+impl Default for Options {
+    fn default() -> Self {
+        Options {
+            tol: 0.005,
+            angle_tol: 0.05f64.to_radians(),
+            spindle_tol: 0.5,
+            tcp: false,
+            interpolate_singular: true,
+        }
+    }
+}
+
+/// One NC motion block.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Step {
+    /// Controller values: X, Y, Z (mm; the tip in the workpiece frame in TCP mode) and rotary
+    /// angles, unwound.
+    pub joints: Joints,
+    /// Controller spindle angle (degrees, unwound), if commanded.
+    pub spindle: Option<f64>,
+    /// The target this block ends at (interpolated for inserted blocks).
+    pub cl: Cl,
+    /// Index of the CL row this block ends at or leads to.
+    pub row: usize,
+    /// Added by linearisation.
+    pub inserted: bool,
+    /// The primary axis was held or interpolated here (singular cone).
+    pub singular: bool,
+}
+
+/// Figures of a plan.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Stats {
+    /// CL rows.
+    pub rows: usize,
+    /// Blocks inserted by linearisation.
+    pub inserted: usize,
+    /// Rows inside the singular cone.
+    pub singular_rows: usize,
+    /// Wrapping axes unwound at a pass start.
+    pub unwinds: usize,
+    /// Largest tip deviation (mm) between blocks, as sampled while linearising.
+    pub tip_deviation: f64,
+    /// Largest axis deviation (radians) between blocks, as sampled while linearising.
+    pub axis_deviation: f64,
+    /// Largest angle (radians) between a pose's tool axis and its CL row's (singular cone).
+    pub pose_axis_error: f64,
+}
+
+/// Why planning failed: the row (index) and what is wrong.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PlanError {
+    /// Index of the CL row.
+    pub row: usize,
+    /// What the user must change.
+    pub message: String,
+    /// True for a pose no solution reaches (input error); false for a check that failed.
+    pub unreachable: bool,
+}
+
+/// Travel limits of X, Y, Z.
+pub type Travel = [Option<[f64; 2]>; 3];
+
+/// Everything planning needs about the machine.
+pub struct Machine<'a> {
+    /// Solver with the chain, policy and singular cone.
+    pub solver: Solver<'a>,
+    /// Linear travel.
+    pub travel: Travel,
+    /// The sixth axis, if any.
+    pub spindle: Option<SpindleSetup>,
+}
+
+impl Machine<'_> {
+    fn chain(&self) -> &Chain {
+        self.solver.chain
+    }
+
+    /// Controller linear values for a tip at rotary angles.
+    fn linear(&self, tip: &P3, rot: &[f64; 2], tcp: bool) -> V3 {
+        if tcp { tip.coords } else { self.chain().linear_for(tip, rot) }
+    }
+
+    /// Controller spindle angle for CL orientation `s` at rotary angles `rot`, near `prev`.
+    fn spindle(&self, rot: &[f64; 2], s: Option<f64>, prev: Option<f64>) -> Option<f64> {
+        let sp = self.spindle?;
+        let s = s?;
+        let a = sp.offset + sp.sense * self.chain().spindle_angle(rot, s);
+        Some(match prev {
+            Some(p) => p + principal_deg(a - p),
+            None => principal_deg(a),
+        })
+    }
+
+    fn check_travel(&self, xyz: &V3) -> Result<(), String> {
+        for (k, name) in ["X", "Y", "Z"].iter().enumerate() {
+            if let Some([lo, hi]) = self.travel[k]
+                && (!xyz[k].is_finite() || xyz[k] < lo - 1e-9 || xyz[k] > hi + 1e-9)
+            {
+                return Err(format!("{name} would be {:.4} mm, outside its travel {lo}..{hi}", xyz[k]));
+            }
+        }
+        Ok(())
+    }
+
+    /// Tip, axis and spindle angle the controller is at for joints `q` and spindle `sigma`.
+    fn at(&self, q: &Joints, tcp: bool) -> (P3, V3) {
+        if tcp {
+            (P3::from(q.xyz), self.chain().orientation(&q.rot).column(2).into_owned())
+        } else {
+            let p = self.chain().forward(q);
+            (p.tip, p.axis)
+        }
+    }
+}
+
+/// Angle between unit vectors (radians), accurate for small angles.
+pub fn angle_between(a: &V3, b: &V3) -> f64 {
+    a.cross(b).norm().atan2(a.dot(b))
+}
+
+/// Distance from `p` to the segment `a`–`b`.
+pub fn point_segment(p: &P3, a: &P3, b: &P3) -> f64 {
+    let d = b - a;
+    let l2 = d.norm_squared();
+    let t = if l2 > 0.0 { ((p - a).dot(&d) / l2).clamp(0.0, 1.0) } else { 0.0 };
+    (p - (a + d * t)).norm()
+}
+
+/// Angle (radians) from unit vector `v` to the shorter great-circle arc from `a` to `b`.
+pub fn vector_arc(v: &V3, a: &V3, b: &V3) -> f64 {
+    let n = a.cross(b);
+    let nn = n.norm();
+    let ends = angle_between(v, a).min(angle_between(v, b));
+    if nn < 1e-15 {
+        return ends;
+    }
+    let n = n / nn;
+    // Project onto the arc's plane; inside the arc's wedge the distance is the angle to the plane.
+    let p = v - n * n.dot(v);
+    if p.norm() < 1e-15 {
+        return ends;
+    }
+    let inside = a.cross(&p).dot(&n) >= 0.0 && p.cross(b).dot(&n) >= 0.0;
+    if inside { n.dot(v).abs().asin() } else { ends }
+}
+
+/// Spherical linear interpolation between unit vectors.
+pub fn slerp(a: &V3, b: &V3, t: f64) -> V3 {
+    let omega = angle_between(a, b);
+    if omega < 1e-12 {
+        return (a * (1.0 - t) + b * t).normalize();
+    }
+    let s = omega.sin();
+    (a * (((1.0 - t) * omega).sin() / s) + b * ((t * omega).sin() / s)).normalize()
+}
+
+fn lerp_joints(a: &Joints, b: &Joints, t: f64) -> Joints {
+    Joints {
+        xyz: a.xyz + (b.xyz - a.xyz) * t,
+        rot: [a.rot[0] + (b.rot[0] - a.rot[0]) * t, a.rot[1] + (b.rot[1] - a.rot[1]) * t],
+    }
+}
+
+/// Poses for every row, before linearisation.
+fn poses(rows: &[Cl], m: &Machine, opts: &Options, stats: &mut Stats) -> Result<Vec<Step>, PlanError> {
+    let chain = m.chain();
+    let n_rot = chain.rotaries().len();
+    let mut prev = [0.0; 2];
+    for (k, r) in chain.rotaries().iter().enumerate() {
+        prev[k] = r.home;
+    }
+    let mut choices = Vec::with_capacity(rows.len());
+    for (i, row) in rows.iter().enumerate() {
+        let mut c =
+            m.solver.choose(&row.axis, &prev).map_err(|e| PlanError { row: i, message: e.0, unreachable: true })?;
+        if row.rapid {
+            for (k, r) in chain.rotaries().iter().enumerate() {
+                if r.wrap && c.rot[k].abs() >= 360.0 {
+                    c.rot[k] = principal_deg(c.rot[k]);
+                    stats.unwinds += 1;
+                }
+            }
+        }
+        prev = c.rot;
+        choices.push(c);
+    }
+    if n_rot == 2 {
+        interpolate_singular_runs(rows, m, opts, &mut choices)?;
+    }
+    let mut steps = Vec::with_capacity(rows.len());
+    let mut sigma: Option<f64> = None;
+    for (i, (row, c)) in rows.iter().zip(&choices).enumerate() {
+        let xyz = m.linear(&row.tip, &c.rot, opts.tcp);
+        m.check_travel(&xyz).map_err(|message| PlanError { row: i, message, unreachable: true })?;
+        let joints = Joints { xyz, rot: c.rot };
+        sigma = m.spindle(&c.rot, row.s, sigma).or(sigma);
+        if c.singular {
+            stats.singular_rows += 1;
+            let axis = chain.orientation(&c.rot).column(2).into_owned();
+            stats.pose_axis_error = stats.pose_axis_error.max(angle_between(&axis, &row.axis));
+        }
+        steps.push(Step {
+            joints,
+            spindle: if row.s.is_some() { sigma } else { None },
+            cl: *row,
+            row: i,
+            inserted: false,
+            singular: c.singular,
+        });
+    }
+    Ok(steps)
+}
+
+/// Inside each run of singular rows of a pass, the primary angle goes linearly (by tip path
+/// length) from its value where the pass enters the cone to its value where it leaves; a run at
+/// the start or end of a pass takes the value of its one non-singular neighbour.
+fn interpolate_singular_runs(
+    rows: &[Cl],
+    m: &Machine,
+    opts: &Options,
+    choices: &mut [camkit::kinematics::Choice],
+) -> Result<(), PlanError> {
+    let mut i = 0;
+    while i < rows.len() {
+        if !choices[i].singular {
+            i += 1;
+            continue;
+        }
+        let start = i;
+        while i < rows.len() && choices[i].singular && (i == start || !rows[i].rapid) {
+            i += 1;
+        }
+        let end = i; // exclusive
+        let before = (start > 0 && !rows[start].rapid).then(|| choices[start - 1].rot[0]);
+        let after = (end < rows.len() && !rows[end].rapid && !choices[end].singular).then(|| choices[end].rot[0]);
+        let (from, to) = match (before, after) {
+            (Some(b), Some(a)) if opts.interpolate_singular => (b, a),
+            (Some(b), _) => (b, b),
+            (None, Some(a)) => (a, a),
+            (None, None) => continue,
+        };
+        let mut lengths = vec![0.0];
+        let first = if before.is_some() { start - 1 } else { start };
+        let last = if after.is_some() { end } else { end - 1 };
+        for k in first + 1..=last {
+            let l = lengths.last().copied().unwrap_or(0.0) + (rows[k].tip - rows[k - 1].tip).norm();
+            lengths.push(l);
+        }
+        let total = lengths.last().copied().unwrap_or(0.0);
+        let mut prev = choices[first].rot;
+        for k in start..end {
+            let t = if total > 0.0 { lengths[k - first] / total } else { 0.5 };
+            let primary = from + (to - from) * t;
+            let c = m.solver.hold(&rows[k].axis, primary, &prev).map_err(|e| PlanError {
+                row: k,
+                message: e.0,
+                unreachable: true,
+            })?;
+            choices[k] = c;
+            prev = c.rot;
+        }
+        // The row leaving the cone was chosen from the held value; keep it continuous with the
+        // interpolated run.
+        if after.is_some() {
+            let c = &mut choices[end];
+            c.rot[1] = prev[1] + principal_deg(c.rot[1] - prev[1]);
+            let limit_ok = m.chain().rotaries()[1].admits(c.rot[1]);
+            if !limit_ok {
+                return Err(PlanError {
+                    row: end,
+                    message: "no continuous pose leaving the singular cone within the limits".into(),
+                    unreachable: true,
+                });
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Deviations of the controller's path between two blocks: (tip mm, axis rad, spindle deg).
+fn segment_deviation(m: &Machine, opts: &Options, a: &Step, b: &Step, samples: &[f64]) -> (f64, f64, f64) {
+    let (axis_a, axis_b) = if a.singular || b.singular {
+        (m.at(&a.joints, opts.tcp).1, m.at(&b.joints, opts.tcp).1)
+    } else {
+        (a.cl.axis, b.cl.axis)
+    };
+    let (mut dt, mut da, mut ds) = (0.0f64, 0.0f64, 0.0f64);
+    for &t in samples {
+        let q = lerp_joints(&a.joints, &b.joints, t);
+        let (tip, axis) = m.at(&q, opts.tcp);
+        dt = dt.max(point_segment(&tip, &a.cl.tip, &b.cl.tip));
+        da = da.max(vector_arc(&axis, &axis_a, &axis_b));
+        if let (Some(sa), Some(sb), Some(ca), Some(cb)) = (a.spindle, b.spindle, a.cl.s, b.cl.s) {
+            let sp = m.spindle.expect("spindle angles need a spindle");
+            let want_s = ca + principal_deg(cb - ca) * t;
+            let want = m.spindle(&q.rot, Some(want_s), Some(sa + (sb - sa) * t)).unwrap_or(0.0);
+            let have = if sp.interpolated { sa + (sb - sa) * t } else { sb };
+            ds = ds.max(principal_deg(have - want).abs());
+        }
+    }
+    (dt, da, ds)
+}
+
+const FINE: [f64; 15] = [
+    1.0 / 16.0,
+    2.0 / 16.0,
+    3.0 / 16.0,
+    4.0 / 16.0,
+    5.0 / 16.0,
+    6.0 / 16.0,
+    7.0 / 16.0,
+    8.0 / 16.0,
+    9.0 / 16.0,
+    10.0 / 16.0,
+    11.0 / 16.0,
+    12.0 / 16.0,
+    13.0 / 16.0,
+    14.0 / 16.0,
+    15.0 / 16.0,
+];
+
+/// Largest rotary move (degrees) below which a segment's deviation is a parabola in t closely
+/// enough that its midpoint, with a factor 2 of margin, stands for its maximum.
+const SMALL_ROTARY_MOVE_DEG: f64 = 2.0;
+
+/// Deepest halving of one CL segment.
+const MAX_DEPTH: u32 = 24;
+
+/// The pose for an inserted block at fraction `t` of the segment `a`–`b`.
+fn inserted(m: &Machine, opts: &Options, a: &Step, b: &Step, t: f64) -> Result<Step, PlanError> {
+    let tip = a.cl.tip + (b.cl.tip - a.cl.tip) * t;
+    let axis = slerp(&a.cl.axis, &b.cl.axis, t);
+    let s = match (a.cl.s, b.cl.s) {
+        (Some(x), Some(y)) => Some(x + principal_deg(y - x) * t),
+        _ => b.cl.s,
+    };
+    let cl = Cl { tip, axis, s, feed: b.cl.feed, rapid: false, line: b.cl.line };
+    let chain = m.chain();
+    let singular = a.singular || b.singular;
+    let c = if singular && chain.rotaries().len() == 2 {
+        let primary = a.joints.rot[0] + (b.joints.rot[0] - a.joints.rot[0]) * t;
+        m.solver.hold(&axis, primary, &a.joints.rot)
+    } else {
+        m.solver.choose(&axis, &a.joints.rot)
+    }
+    .map_err(|e| PlanError { row: b.row, message: e.0, unreachable: true })?;
+    let xyz = m.linear(&tip, &c.rot, opts.tcp);
+    m.check_travel(&xyz).map_err(|message| PlanError { row: b.row, message, unreachable: true })?;
+    let spindle = m.spindle(&c.rot, s, a.spindle).filter(|_| s.is_some());
+    Ok(Step { joints: Joints { xyz, rot: c.rot }, spindle, cl, row: b.row, inserted: true, singular })
+}
+
+fn linearise(
+    m: &Machine,
+    opts: &Options,
+    a: &Step,
+    b: &Step,
+    depth: u32,
+    out: &mut Vec<Step>,
+    stats: &mut Stats,
+) -> Result<(), PlanError> {
+    let rot_move = (0..2).map(|k| (b.joints.rot[k] - a.joints.rot[k]).abs()).fold(0.0, f64::max);
+    let spin_move = match (a.spindle, b.spindle) {
+        (Some(x), Some(y)) => (y - x).abs(),
+        _ => 0.0,
+    };
+    let small = rot_move <= SMALL_ROTARY_MOVE_DEG && spin_move <= SMALL_ROTARY_MOVE_DEG;
+    let (dt, da, ds) = if small {
+        let (dt, da, ds) = segment_deviation(m, opts, a, b, &[0.5]);
+        if dt <= opts.tol / 2.0 && da <= opts.angle_tol / 2.0 && ds <= opts.spindle_tol / 2.0 {
+            (dt * 2.0, da * 2.0, ds * 2.0)
+        } else {
+            segment_deviation(m, opts, a, b, &FINE)
+        }
+    } else {
+        segment_deviation(m, opts, a, b, &FINE)
+    };
+    if dt <= opts.tol && da <= opts.angle_tol && ds <= opts.spindle_tol {
+        stats.tip_deviation = stats.tip_deviation.max(dt);
+        stats.axis_deviation = stats.axis_deviation.max(da);
+        out.push(*b);
+        return Ok(());
+    }
+    if depth >= MAX_DEPTH {
+        return Err(PlanError {
+            row: b.row,
+            message: format!(
+                "the machine cannot follow the tool between this row and the previous one within the tolerances \
+                 (tip {dt:.6} mm, axis {:.4}°, rotary move {rot_move:.3}°): the rotary axes change branch or pass \
+                 through the singularity here; split the pass or widen the axis limits",
+                da.to_degrees()
+            ),
+            unreachable: true,
+        });
+    }
+    let mid = inserted(m, opts, a, b, 0.5)?;
+    stats.inserted += 1;
+    linearise(m, opts, a, &mid, depth + 1, out, stats)?;
+    let mid = *out.last().expect("the first half ends at the midpoint");
+    linearise(m, opts, &mid, b, depth + 1, out, stats)
+}
+
+/// Plans the blocks for CL rows on a machine.
+pub fn plan(rows: &[Cl], m: &Machine, opts: &Options) -> Result<(Vec<Step>, Stats), PlanError> {
+    let mut stats = Stats { rows: rows.len(), ..Stats::default() };
+    let steps = poses(rows, m, opts, &mut stats)?;
+    let mut out = Vec::with_capacity(steps.len() + steps.len() / 8);
+    for (i, step) in steps.iter().enumerate() {
+        if i == 0 || step.cl.rapid {
+            out.push(*step);
+            continue;
+        }
+        let a = *out.last().expect("a previous block");
+        linearise(m, opts, &a, step, 0, &mut out, &mut stats)?;
+    }
+    Ok((out, stats))
+}

@@ -1,0 +1,288 @@
+//! Reading NC back: every block through the forward kinematics to the tool tip, axis and spindle
+//! orientation in the workpiece frame; the controller's linear interpolation sampled between
+//! blocks and compared with the CL rows both ways (`--verify`), or written out as the toolpath
+//! table (`--reverse`).
+
+use crate::plan::{Cl, angle_between, point_segment, slerp};
+use camkit::doc::machine::{Machine, SpindleMode};
+use camkit::gcode::{AXIS_LETTERS, AxisProgram, Motion};
+use camkit::geom::{P3, V3};
+use camkit::kinematics::{Chain, Joints, principal_deg};
+use camkit::table::{Col, Move, Row, Schema, Table};
+
+/// How to read a program for one machine.
+#[derive(Clone, Debug)]
+pub struct Reading<'a> {
+    /// The chain with the workpiece frame.
+    pub chain: &'a Chain,
+    /// X, Y, Z are the tool tip in the workpiece frame (G43.4).
+    pub tcp: bool,
+    /// Index into [`AXIS_LETTERS`] of each rotary axis.
+    pub rotary_at: Vec<usize>,
+    /// The spindle orientation: mode, index of its address (axis mode), offset, sense.
+    pub spindle: Option<(SpindleMode, Option<usize>, f64, f64)>,
+}
+
+impl<'a> Reading<'a> {
+    /// The reading for a machine document and its chain.
+    pub fn new(machine: &Machine, chain: &'a Chain) -> Reading<'a> {
+        let at = |c: char| AXIS_LETTERS.iter().position(|&l| l == c as u8).expect("A, B or C");
+        Reading {
+            chain,
+            tcp: machine.program.tcp,
+            rotary_at: chain.rotaries().iter().map(|r| at(r.address)).collect(),
+            spindle: machine.spindle.as_ref().map(|s| (s.mode, machine.spindle_address().map(at), s.offset, s.sense)),
+        }
+    }
+}
+
+/// One motion block read back.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct NcPose {
+    /// Source line.
+    pub line: u32,
+    /// G0.
+    pub rapid: bool,
+    /// Controller values.
+    pub joints: Joints,
+    /// Controller spindle angle, if commanded so far.
+    pub sigma: Option<f64>,
+    /// G93 in effect.
+    pub inverse_time: bool,
+    /// F in effect.
+    pub feed: Option<f64>,
+}
+
+/// The motion blocks of a program as poses; `None` for blocks in machine coordinates (G53) or
+/// before every axis the machine needs has a known position.
+pub fn poses(prog: &AxisProgram, r: &Reading) -> Vec<Option<NcPose>> {
+    let mut sigma_axis_seen = false;
+    prog.moves
+        .iter()
+        .map(|m| {
+            let needed = (0..3).chain(r.rotary_at.iter().copied());
+            if m.machine_coords || needed.clone().any(|k| !m.known[k]) {
+                return None;
+            }
+            let mut rot = [0.0; 2];
+            for (k, &at) in r.rotary_at.iter().enumerate() {
+                rot[k] = m.pos[at];
+            }
+            let sigma = match r.spindle {
+                Some((SpindleMode::Axis, Some(at), ..)) => {
+                    sigma_axis_seen |= m.known[at];
+                    sigma_axis_seen.then_some(m.pos[at])
+                }
+                Some((SpindleMode::M19, ..)) => m.orient,
+                _ => None,
+            };
+            Some(NcPose {
+                line: m.line,
+                rapid: m.motion == Motion::Rapid,
+                joints: Joints { xyz: V3::new(m.pos[0], m.pos[1], m.pos[2]), rot },
+                sigma,
+                inverse_time: m.inverse_time,
+                feed: m.feed,
+            })
+        })
+        .collect()
+}
+
+impl Reading<'_> {
+    /// Tip and axis in the workpiece frame for controller values.
+    pub fn at(&self, q: &Joints) -> (P3, V3) {
+        if self.tcp {
+            (P3::from(q.xyz), self.chain.orientation(&q.rot).column(2).into_owned())
+        } else {
+            let p = self.chain.forward(q);
+            (p.tip, p.axis)
+        }
+    }
+
+    /// The CL spindle orientation `s` for a controller spindle angle.
+    pub fn s_of(&self, rot: &[f64; 2], sigma: f64) -> Option<f64> {
+        let (_, _, offset, sense) = self.spindle?;
+        Some(self.chain.edge_orientation(rot, (sigma - offset) * sense))
+    }
+}
+
+/// Largest deviations of a program from its CL rows.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Deviation {
+    /// Largest distance (mm) of the interpolated tool tip from the CL polyline.
+    pub tip: f64,
+    /// NC line where it occurs.
+    pub tip_line: u32,
+    /// Largest distance (mm) of a CL row from the program's path (every row is cut).
+    pub coverage: f64,
+    /// Index of that CL row.
+    pub coverage_row: usize,
+    /// Largest angle (degrees) between the interpolated tool axis and the CL axis there.
+    pub axis_deg: f64,
+    /// NC line where it occurs.
+    pub axis_line: u32,
+    /// Largest error (degrees) of the spindle orientation.
+    pub spindle_deg: f64,
+    /// Feed blocks compared.
+    pub blocks: usize,
+    /// Points sampled.
+    pub samples: usize,
+}
+
+/// Index of the segment of `segs` (pairs of CL indices) nearest `p`, searched near `hint` first.
+fn nearest(p: &P3, cl: &[Cl], segs: &[(usize, usize)], hint: usize, far: f64) -> (usize, f64) {
+    let lo = hint.saturating_sub(2);
+    let hi = (hint + 16).min(segs.len());
+    let mut best = (hint.min(segs.len().saturating_sub(1)), f64::INFINITY);
+    for (k, &(a, b)) in segs.iter().enumerate().take(hi).skip(lo) {
+        let d = point_segment(p, &cl[a].tip, &cl[b].tip);
+        if d < best.1 {
+            best = (k, d);
+        }
+    }
+    if best.1 > far {
+        for (k, &(a, b)) in segs.iter().enumerate() {
+            let d = point_segment(p, &cl[a].tip, &cl[b].tip);
+            if d < best.1 {
+                best = (k, d);
+            }
+        }
+    }
+    best
+}
+
+/// Parameter of the point of segment `a`–`b` nearest `p`.
+fn param(p: &P3, a: &P3, b: &P3) -> f64 {
+    let d = b - a;
+    let l2 = d.norm_squared();
+    if l2 > 0.0 { ((p - a).dot(&d) / l2).clamp(0.0, 1.0) } else { 0.0 }
+}
+
+/// Compares a program with the CL rows it was made from: every feed block sampled
+/// `samples_per_block` times along the controller's linear interpolation of every axis against
+/// the CL polyline (tip, axis, spindle orientation), and every CL row against the program's path.
+pub fn verify(cl: &[Cl], poses: &[Option<NcPose>], r: &Reading, samples_per_block: usize, far: f64) -> Deviation {
+    let segs: Vec<(usize, usize)> = (1..cl.len()).filter(|&i| !cl[i].rapid).map(|i| (i - 1, i)).collect();
+    let mut dev = Deviation::default();
+    let mut hint = 0;
+    let mut path: Vec<P3> = Vec::with_capacity(poses.len());
+    let mut prev: Option<&NcPose> = None;
+    for pose in poses {
+        let Some(b) = pose else {
+            prev = None;
+            continue;
+        };
+        path.push(r.at(&b.joints).0);
+        let Some(a) = prev.filter(|_| !b.rapid) else {
+            prev = Some(b);
+            continue;
+        };
+        prev = Some(b);
+        if segs.is_empty() {
+            continue;
+        }
+        dev.blocks += 1;
+        for k in 0..=samples_per_block {
+            let t = k as f64 / samples_per_block as f64;
+            let q = Joints {
+                xyz: a.joints.xyz + (b.joints.xyz - a.joints.xyz) * t,
+                rot: [
+                    a.joints.rot[0] + (b.joints.rot[0] - a.joints.rot[0]) * t,
+                    a.joints.rot[1] + (b.joints.rot[1] - a.joints.rot[1]) * t,
+                ],
+            };
+            let (tip, axis) = r.at(&q);
+            let (seg, d) = nearest(&tip, cl, &segs, hint, far);
+            hint = seg;
+            dev.samples += 1;
+            if d > dev.tip {
+                dev.tip = d;
+                dev.tip_line = b.line;
+            }
+            let (i0, i1) = segs[seg];
+            let u = param(&tip, &cl[i0].tip, &cl[i1].tip);
+            let want = slerp(&cl[i0].axis, &cl[i1].axis, u);
+            let da = angle_between(&axis, &want).to_degrees();
+            if da > dev.axis_deg {
+                dev.axis_deg = da;
+                dev.axis_line = b.line;
+            }
+            let sigma = match (r.spindle, a.sigma, b.sigma) {
+                (Some((SpindleMode::Axis, ..)), Some(x), Some(y)) => Some(x + (y - x) * t),
+                (Some((SpindleMode::M19, ..)), _, y) => y,
+                _ => None,
+            };
+            if let (Some(sig), Some(s0), Some(s1)) = (sigma, cl[i0].s, cl[i1].s) {
+                let want_s = s0 + principal_deg(s1 - s0) * u;
+                if let Some(have) = r.s_of(&q.rot, sig) {
+                    dev.spindle_deg = dev.spindle_deg.max(principal_deg(have - want_s).abs());
+                }
+            }
+        }
+    }
+    // Coverage: every CL row lies on the program's path.
+    let mut j = 0usize;
+    for (i, row) in cl.iter().enumerate() {
+        if path.is_empty() {
+            dev.coverage = f64::INFINITY;
+            break;
+        }
+        let mut best = (j, f64::INFINITY);
+        let scan = |lo: usize, hi: usize, best: &mut (usize, f64)| {
+            for k in lo..hi {
+                let d = if k + 1 < path.len() {
+                    point_segment(&row.tip, &path[k], &path[k + 1])
+                } else {
+                    (row.tip - path[k]).norm()
+                };
+                if d < best.1 {
+                    *best = (k, d);
+                }
+            }
+        };
+        scan(j.saturating_sub(2), (j + 64).min(path.len()), &mut best);
+        if best.1 > far {
+            scan(0, path.len(), &mut best);
+        }
+        j = best.0;
+        if best.1 > dev.coverage {
+            dev.coverage = best.1;
+            dev.coverage_row = i;
+        }
+    }
+    dev
+}
+
+/// The program as a toolpath table: tool tip, axis, spindle orientation and feed (mm/min) per
+/// block; a new `path` after every run of rapids.
+pub fn reverse(poses: &[Option<NcPose>], r: &Reading) -> Table {
+    let mut rows = Vec::new();
+    let mut path = 0i64;
+    let mut last: Option<(P3, bool)> = None;
+    let has_s = r.spindle.is_some();
+    for pose in poses.iter().flatten() {
+        let (tip, axis) = r.at(&pose.joints);
+        if pose.rapid && last.is_some_and(|(_, rapid)| !rapid) {
+            path += 1;
+        }
+        let mut row = Row::at(path, tip);
+        row.mv = if pose.rapid { Move::Rapid } else { Move::Line };
+        row.axis = axis;
+        row.s = pose.sigma.and_then(|s| r.s_of(&pose.joints.rot, s));
+        row.line = u64::from(pose.line);
+        if !pose.rapid {
+            row.f = match (pose.inverse_time, pose.feed, last) {
+                (false, f, _) => f,
+                (true, Some(f), Some((p, _))) => Some(f * (tip - p).norm()),
+                _ => None,
+            };
+        }
+        last = Some((tip, pose.rapid));
+        rows.push(row);
+    }
+    let mut schema = Schema::of(&[Col::Path, Col::Move, Col::X, Col::Y, Col::Z, Col::I, Col::J, Col::K, Col::F]);
+    if has_s {
+        schema.add(&[Col::S]);
+    }
+    Table { schema, rows }
+}

@@ -1,0 +1,457 @@
+//! End-to-end tests of `post-6axis`: synthetic CL on spheres (tool axis along the normal, tilted
+//! towards the feed, with and without a spindle orientation stream) posted for every machine in
+//! `data/post-6axis/`, read back by the filter's own `--verify`, by an independent forward
+//! kinematics in this file, and by LinuxCNC's interpreter where it is installed; bad input refused
+//! with one line and no output file.
+
+use camkit::geom::{P3, V3};
+use camkit::kinematics::edge_angle;
+use e2e::{Work, data};
+use std::fmt::Write;
+
+const BIN: &str = "post-6axis";
+
+fn machine(name: &str) -> String {
+    data(&format!("post-6axis/{name}")).to_str().unwrap().to_string()
+}
+
+fn report(w: &Work, name: &str) -> serde_json::Value {
+    serde_json::from_str(&w.read(name)).expect("report is JSON")
+}
+
+/// One CL row.
+#[derive(Clone, Copy, Debug)]
+struct Row {
+    path: i64,
+    rapid: bool,
+    tip: P3,
+    axis: V3,
+    s: Option<f64>,
+}
+
+fn csv(rows: &[Row], feed: f64) -> String {
+    let with_s = rows.iter().any(|r| r.s.is_some());
+    let mut out = String::from(if with_s { "path,move,x,y,z,i,j,k,s,f\n" } else { "path,move,x,y,z,i,j,k,f\n" });
+    for r in rows {
+        let mv = if r.rapid { "rapid" } else { "line" };
+        write!(out, "{},{mv},{},{},{},{},{},{}", r.path, r.tip.x, r.tip.y, r.tip.z, r.axis.x, r.axis.y, r.axis.z)
+            .unwrap();
+        if let Some(s) = r.s {
+            write!(out, ",{s}").unwrap();
+        }
+        writeln!(out, ",{feed}").unwrap();
+    }
+    out
+}
+
+/// Scan lines along X over the top of a sphere (centre `c`, radius `r`) at the given Y values,
+/// every `step` mm, tool tip on the surface, tool axis along the normal tilted by `tilt` degrees
+/// towards the feed (paper 000's cylindrical tool uses −5°), spindle orientation facing the feed
+/// when `with_s`.
+fn sphere_scan(c: P3, r: f64, ys: &[f64], half_width: f64, step: f64, tilt: f64, with_s: bool) -> Vec<Row> {
+    let mut rows = Vec::new();
+    for (path, &y) in ys.iter().enumerate() {
+        let n = (2.0 * half_width / step).round() as usize;
+        let pts: Vec<P3> = (0..=n)
+            .map(|k| {
+                let x = c.x - half_width + k as f64 * step;
+                let z = c.z + (r * r - (x - c.x).powi(2) - (y - c.y).powi(2)).sqrt();
+                P3::new(x, y, z)
+            })
+            .collect();
+        for (k, p) in pts.iter().enumerate() {
+            let normal = (p - c) / r;
+            let next = if k + 1 < pts.len() { pts[k + 1] - p } else { p - pts[k - 1] };
+            let feed_dir = (next - normal * normal.dot(&next)).normalize();
+            let t = tilt.to_radians();
+            let axis = (normal * t.cos() + feed_dir * t.sin()).normalize();
+            let s = with_s.then(|| edge_angle(&axis, &(feed_dir - axis * axis.dot(&feed_dir)).normalize()));
+            rows.push(Row { path: path as i64, rapid: k == 0, tip: *p, axis, s });
+        }
+    }
+    rows
+}
+
+/// A globe-like contour: a latitude circle and a meridian over the pole of a sphere about the
+/// workpiece origin, tool axis along the normal (paper 002's flat end mill on the A/C machine).
+fn globe(r: f64) -> Vec<Row> {
+    let mut rows = Vec::new();
+    let on = |lat: f64, lon: f64| {
+        let (la, lo) = (lat.to_radians(), lon.to_radians());
+        let n = V3::new(la.cos() * lo.cos(), la.cos() * lo.sin(), la.sin());
+        (P3::from(n * r), n)
+    };
+    for k in 0..=360 {
+        let (tip, axis) = on(35.0, k as f64);
+        rows.push(Row { path: 0, rapid: k == 0, tip, axis, s: None });
+    }
+    // Over the pole: the tool axis passes through the C axis direction (the singularity), and
+    // down to latitude 70° on the far side (A = −20°, inside its −30..120 limits).
+    for k in 0..=87 {
+        let lat = 40.0 + k as f64 * 0.8;
+        let (lat, lon) = if lat > 90.0 { (180.0 - lat, 200.0) } else { (lat, 20.0) };
+        let (tip, axis) = on(lat, lon);
+        rows.push(Row { path: 1, rapid: k == 0, tip, axis, s: None });
+    }
+    rows
+}
+
+/// Posts `rows` for `machine_file` and returns the report, checking success.
+fn post(w: &Work, rows: &[Row], machine_file: &str, extra: &[&str], out: &str) -> serde_json::Value {
+    w.write("cl.csv", csv(rows, 800.0));
+    let rep = format!("{out}.json");
+    let mut args = vec!["cl.csv", "--machine", machine_file, "-o", out, "--report", &rep];
+    args.extend_from_slice(extra);
+    w.run(BIN, &args, b"").ok();
+    report(w, &rep)
+}
+
+fn figure(r: &serde_json::Value, key: &str) -> f64 {
+    r[key].as_f64().unwrap_or_else(|| panic!("report lacks {key}: {r}"))
+}
+
+/// Paper 002's A/C chain with its offsets written out by hand (eq. 2 with table axes turning the
+/// workpiece the positive way): an instrument independent of camkit's chain code.
+fn paper_002_forward(x: f64, y: f64, z: f64, a: f64, c: f64) -> (P3, V3) {
+    let (xc, yc, za, yac) = (0.42, -0.31, 62.5, 0.35);
+    let (sa, ca) = (-a).to_radians().sin_cos();
+    let (sc, cc) = (-c).to_radians().sin_cos();
+    // Rx(−a)·(x, y, z), then + (0, yac, 0), then Rz(−c), then + (xc, yc, za).
+    let (x1, y1, z1) = (x, y * ca - z * sa, y * sa + z * ca);
+    let y1 = y1 + yac;
+    let (x2, y2) = (x1 * cc - y1 * sc, x1 * sc + y1 * cc);
+    let tip = P3::new(x2 + xc, y2 + yc, z1 + za);
+    let axis = V3::new(-(-sa) * sc, (-sa) * cc, ca);
+    (tip, axis)
+}
+
+/// X Y Z A C of every G1/G0 block of a program (modal values carried), by plain text parsing.
+fn blocks(nc: &str) -> Vec<[f64; 5]> {
+    let mut v = [0.0; 5];
+    let mut out = Vec::new();
+    for line in nc.lines() {
+        let line = line.split('(').next().unwrap();
+        let words: Vec<&str> = line.split_whitespace().collect();
+        if words.iter().any(|w| *w == "G53")
+            || !words.iter().any(|w| ["X", "Y", "Z", "A", "C"].iter().any(|l| w.starts_with(l)))
+        {
+            continue;
+        }
+        for w in words {
+            if let Some(k) = ["X", "Y", "Z", "A", "C"].iter().position(|l| w.starts_with(l)) {
+                v[k] = w[1..].parse().unwrap();
+            }
+        }
+        out.push(v);
+    }
+    out
+}
+
+#[test]
+fn globe_on_the_ac_machine_reads_back_within_a_micrometre() {
+    let w = Work::new();
+    let rows = globe(25.0);
+    let r = post(&w, &rows, &machine("paper002-ac.json"), &["--tol", "0.001"], "globe.nc");
+    assert!(figure(&r, "largest_tip_deviation_mm") <= 0.001, "{r}");
+    assert!(figure(&r, "largest_row_distance_mm") <= 0.001, "{r}");
+    assert!(figure(&r, "singular_rows") > 0.0, "the meridian crosses the pole: {r}");
+    assert!(figure(&r, "inserted_blocks") > 0.0, "{r}");
+    // --verify on the written program says the same, with denser sampling.
+    let v = w.run(
+        BIN,
+        &["cl.csv", "--machine", &machine("paper002-ac.json"), "--verify", "globe.nc", "--tol", "0.001"],
+        b"",
+    );
+    let v: serde_json::Value = serde_json::from_str(&v.ok()).unwrap();
+    assert!(figure(&v, "largest_tip_deviation_mm") <= 0.001, "{v}");
+    // The independent instrument: every block end through eq. 2 by hand lies on the CL polyline
+    // of its pass, and C never spins more than the singular rule allows between two blocks.
+    let nc = w.read("globe.nc");
+    let b = blocks(&nc);
+    assert!(b.len() > rows.len());
+    let mut worst = 0.0f64;
+    for q in &b {
+        let (tip, _) = paper_002_forward(q[0], q[1], q[2], q[3], q[4]);
+        let d = rows
+            .windows(2)
+            .filter(|p| !p[1].rapid)
+            .map(|p| camkit::geom::dist::point_segment(&tip, &p[0].tip, &p[1].tip))
+            .fold(f64::INFINITY, f64::min);
+        worst = worst.max(d);
+    }
+    assert!(worst <= 0.001, "block ends lie {worst} mm from the CL by eq. 2 written out");
+    let biggest_c_step = b.windows(2).map(|p| (p[1][4] - p[0][4]).abs()).fold(0.0, f64::max);
+    assert!(biggest_c_step < 30.0, "C spins {biggest_c_step}° in one block near the pole");
+    // G93 on rotary blocks, G94 back before the end, every feed block has F.
+    assert!(nc.contains("G93 G1") && nc.contains("\nG94\n"));
+    for line in nc.lines().filter(|l| l.starts_with("G93") || (l.starts_with('X') && l.contains('A'))) {
+        assert!(line.contains('F'), "inverse-time block without F: {line}");
+    }
+}
+
+#[test]
+fn paper_002_twin_solution_and_eq_3_4() {
+    // A single pose tilted 30° about the workpiece: eq. 3–4 give a = 30°, c = atan2(u, v).
+    let w = Work::new();
+    let t = 30.0f64.to_radians();
+    let phi = 40.0f64.to_radians();
+    let axis = V3::new(t.sin() * phi.cos(), t.sin() * phi.sin(), t.cos());
+    let rows = vec![
+        Row { path: 0, rapid: true, tip: P3::new(1.0, 2.0, 3.0), axis, s: None },
+        Row { path: 0, rapid: false, tip: P3::new(1.5, 2.0, 3.0), axis, s: None },
+    ];
+    post(&w, &rows, &machine("paper002-ac.json"), &[], "one.nc");
+    let b = blocks(&w.read("one.nc"));
+    let (a, c) = (b[0][3], b[0][4]);
+    assert!((a - 30.0).abs() < 1e-4, "a = {a}");
+    assert!((c - axis.x.atan2(axis.y).to_degrees()).abs() < 1e-4, "c = {c}");
+    let (tip, got) = paper_002_forward(b[0][0], b[0][1], b[0][2], a, c);
+    assert!((tip - rows[0].tip).norm() < 2e-4 && (got - axis).norm() < 1e-5, "{tip:?} {got:?}");
+}
+
+#[test]
+fn every_machine_family_posts_and_reads_back() {
+    let w = Work::new();
+    // A cap of radius 60 tilted at most ~35°, tool axis along the normal.
+    let cap = sphere_scan(P3::new(0.0, 0.0, -40.0), 60.0, &[-20.0, 0.0, 25.0], 30.0, 1.0, 0.0, false);
+    for name in [
+        "paper002-ac.json",
+        "paper002-ac-fanuc-tcp.json",
+        "table-bc-fanuc.json",
+        "head-bc.json",
+        "head-ab.json",
+        "head-table-cb.json",
+    ] {
+        let r = post(&w, &cap, &machine(name), &[], "m.nc");
+        assert!(figure(&r, "largest_tip_deviation_mm") <= 0.005, "{name}: {r}");
+        assert!(figure(&r, "largest_axis_deviation_deg") <= 0.05, "{name}: {r}");
+        let v = w.run(BIN, &["cl.csv", "--machine", &machine(name), "--verify", "m.nc"], b"");
+        let v: serde_json::Value = serde_json::from_str(&v.ok()).unwrap();
+        assert!(figure(&v, "largest_tip_deviation_mm") <= 0.005, "{name}: {v}");
+        let nc = w.read("m.nc");
+        assert!(nc.starts_with("%\n") && nc.trim_end().ends_with("M30\n%"), "{name}: header and footer");
+        if name.contains("fanuc") {
+            assert!(nc.contains("\nO"), "{name}: program number");
+        }
+        if name.contains("tcp") {
+            assert!(nc.contains("G43.4 H1") && !nc.contains("G93"), "{name}: TCP mode, feed per minute");
+            assert!(nc.contains("N10 "), "{name}: block numbers");
+        }
+    }
+    // A flat pass for the three-axis machine; a tilted axis is refused there.
+    let flat: Vec<Row> = (0..50)
+        .map(|k| Row { path: 0, rapid: k == 0, tip: P3::new(10.0 + k as f64, 20.0, -5.0), axis: V3::z(), s: None })
+        .collect();
+    let r = post(&w, &flat, &machine("three-axis.json"), &[], "flat.nc");
+    assert_eq!(figure(&r, "inserted_blocks"), 0.0);
+    assert!(!w.read("flat.nc").contains('A'));
+    w.write("tilted.csv", csv(&cap, 500.0));
+    w.run(BIN, &["tilted.csv", "--machine", &machine("three-axis.json")], b"").fails(2, "no rotary axis");
+}
+
+#[test]
+fn six_axis_spindle_orientation_follows_the_feed() {
+    let w = Work::new();
+    // Paper 000's smoothing: R500 sphere, tool tilted −5° towards the feed, pick feed 1 mm.
+    let c = P3::new(0.0, 0.0, -500.0);
+    let ys: Vec<f64> = (0..5).map(|k| -2.0 + k as f64).collect();
+    let rows = sphere_scan(c, 500.0, &ys, 40.0, 0.5, -5.0, true);
+    for name in ["paper000-sixaxis-m19.json", "paper000-sixaxis-b.json"] {
+        let r = post(&w, &rows, &machine(name), &["--tol", "0.001"], "six.nc");
+        assert!(figure(&r, "largest_tip_deviation_mm") <= 0.001, "{name}: {r}");
+        assert!(figure(&r, "largest_spindle_deviation_deg") <= 0.5, "{name}: {r}");
+        let nc = w.read("six.nc");
+        if name.contains("m19") {
+            assert!(figure(&r, "spindle_orients") > 0.0 && nc.contains("M19 R"), "{name}");
+        } else {
+            assert!(nc.lines().any(|l| l.contains(" B")), "{name}: B words");
+        }
+        // Reverse: the NC back as a table carries the spindle orientation of the rows.
+        let back = w.run(BIN, &["six.nc", "--machine", &machine(name), "--reverse"], b"");
+        let text = back.ok();
+        let header = text.lines().next().unwrap();
+        assert!(header.contains(",s"), "{header}");
+        let s_col = header.split(',').position(|c| c == "s").unwrap();
+        let mut matched = 0;
+        for line in text.lines().skip(1) {
+            let f: Vec<&str> = line.split(',').collect();
+            let p = P3::new(f[2].parse().unwrap(), f[3].parse().unwrap(), f[4].parse().unwrap());
+            let (dist, row) = rows
+                .iter()
+                .map(|r| ((r.tip - p).norm(), r))
+                .fold((f64::INFINITY, &rows[0]), |a, b| if b.0 < a.0 { b } else { a });
+            if dist < 3e-4
+                && let Ok(s) = f[s_col].parse::<f64>()
+            {
+                let d = camkit::kinematics::principal_deg(s - row.s.unwrap()).abs();
+                assert!(d < 0.5, "{name}: s {s} vs {}", row.s.unwrap());
+                matched += 1;
+            }
+        }
+        assert!(matched > rows.len() / 2, "{name}: {matched} rows matched");
+    }
+}
+
+#[test]
+fn reverse_gives_the_rows_back() {
+    let w = Work::new();
+    let rows = globe(25.0);
+    post(&w, &rows, &machine("paper002-ac.json"), &["--tol", "0.001"], "g.nc");
+    let out = w.run(BIN, &["g.nc", "--machine", &machine("paper002-ac.json"), "--reverse", "-o", "back.csv"], b"");
+    out.ok();
+    let text = w.read("back.csv");
+    assert!(text.starts_with("path,move,x,y,z,i,j,k,f\n"), "{}", &text[..60]);
+    // Every CL row is one of the reversed rows (to the rounding of 4 decimals).
+    let back: Vec<[f64; 6]> = text
+        .lines()
+        .skip(1)
+        .map(|l| {
+            let f: Vec<f64> = l.split(',').skip(2).take(6).map(|v| v.parse().unwrap()).collect();
+            [f[0], f[1], f[2], f[3], f[4], f[5]]
+        })
+        .collect();
+    for r in &rows {
+        let best = back.iter().map(|b| (P3::new(b[0], b[1], b[2]) - r.tip).norm()).fold(f64::INFINITY, f64::min);
+        assert!(best < 3e-4, "row {:?} is {best} mm from every reversed row", r.tip);
+    }
+}
+
+#[test]
+fn the_workpiece_frame_document_moves_the_program() {
+    let w = Work::new();
+    let rows = globe(25.0);
+    post(&w, &rows, &machine("paper002-ac.json"), &[], "a.nc");
+    w.write("frame.json", r#"{"xc": 1.0, "yc": 2.0, "za": 50.0, "source": "surf-probe-fit", "fit": {"radius": 25.0}}"#);
+    post(&w, &rows, &machine("paper002-ac.json"), &["--frame", "frame.json"], "b.nc");
+    assert_ne!(w.read("a.nc"), w.read("b.nc"));
+    let ok = w.run(
+        BIN,
+        &["cl.csv", "--machine", &machine("paper002-ac.json"), "--frame", "frame.json", "--verify", "b.nc"],
+        b"",
+    );
+    ok.ok();
+    // The other frame's program does not fit this frame: the check fails with status 1.
+    let bad = w.run(
+        BIN,
+        &["cl.csv", "--machine", &machine("paper002-ac.json"), "--frame", "frame.json", "--verify", "a.nc"],
+        b"",
+    );
+    bad.fails(1, "deviates");
+    w.write("bad-frame.json", r#"{"xc": 1.0, "yc": 2.0}"#);
+    let e = w.run(BIN, &["cl.csv", "--machine", &machine("paper002-ac.json"), "--frame", "bad-frame.json"], b"");
+    e.fails(2, "missing field `za`");
+}
+
+#[test]
+fn bad_input_is_refused_without_output() {
+    let w = Work::new();
+    let m = machine("paper002-ac.json");
+    let run = |csv: &str| {
+        w.write("in.csv", csv);
+        w.run(BIN, &["in.csv", "--machine", &m, "-o", "out.nc"], b"")
+    };
+    // A (tilt) beyond 120°: neither branch is inside −30..120.
+    let t = 135.0f64.to_radians();
+    let out = run(&format!("x,y,z,i,j,k,f\n0,0,0,0,0,1,100\n1,0,0,{},0,{},100\n", t.sin(), t.cos()));
+    out.fails(2, "in.csv:3 (i,j,k): no solution within the axis limits");
+    assert!(out.stderr.contains("-30..120"), "{}", out.stderr);
+    assert!(!w.exists("out.nc"), "no partial program");
+    run("x,y,z,i,j,k,f\n0,0,0,0,0,1.01,100\n").fails(2, "in.csv:2 (i,j,k): the tool axis has length 1.01, not 1");
+    let near = run("x,y,z,i,j,k,f\n0,0,0,0,0,1.0004,100\n1,0,0,0,0,1,100\n");
+    near.ok();
+    assert!(near.stderr.contains("normalised"), "{}", near.stderr);
+    std::fs::remove_file(w.path("out.nc")).unwrap();
+    run("x,y,z,f\n0,0,0,100\n").fails(2, "missing columns i, j, k");
+    run("x,y,z,i,j,k,f\n0,0,NaN,0,0,1,100\n").fails(2, "in.csv:2:3 (z): expected a finite number");
+    run("x,y,z,i,j,k\n0,0,0,0,0,1\n1,0,0,0,0,1\n").fails(2, "in.csv:3 (f): no feed");
+    run("x,y,z,i,j,k,s,f\n0,0,0,0,0,1,10,100\n").fails(2, "no `spindle`");
+    run("x,y,z,i,j,k,f,move,xc,yc\n0,0,0,0,0,1,100,line,,\n1,1,0,0,0,1,100,cw,0,1\n").fails(2, "arcs");
+    run("").fails(2, "empty input");
+    assert!(!w.exists("out.nc"));
+    // Over the pole and down to latitude 59.6° beyond it, A would pass −30°: the machine must
+    // change branch (A and C by 180°) in the middle of the cut, which it is not allowed to do.
+    let mut over = String::from("path,x,y,z,i,j,k,f\n");
+    for k in 0..=140 {
+        let lat: f64 = 40.0 + k as f64 * 0.8;
+        let (lat, lon) = if lat > 90.0 { (180.0 - lat, 200.0f64) } else { (lat, 20.0f64) };
+        let (la, lo) = (lat.to_radians(), lon.to_radians());
+        let n = V3::new(la.cos() * lo.cos(), la.cos() * lo.sin(), la.sin());
+        over.push_str(&format!("0,{},{},{},{},{},{},300\n", 25.0 * n.x, 25.0 * n.y, 25.0 * n.z, n.x, n.y, n.z));
+    }
+    run(&over).fails(2, "cannot follow the tool");
+    assert!(!w.exists("out.nc"));
+    // Travel limits are checked too.
+    w.write("far.csv", "x,y,z,i,j,k,f\n0,0,0,0,0,1,100\n600,0,0,0,0,1,100\n");
+    w.run(BIN, &["far.csv", "--machine", &m], b"").fails(2, "X would be");
+    // A bad machine document names the JSON path.
+    w.write("m.json", r#"{"name": "x", "chain": [{"rotary": "A", "min": 10}, {"linear": true}]}"#);
+    w.write("ok.csv", "x,y,z,i,j,k,f\n0,0,0,0,0,1,100\n");
+    w.run(BIN, &["ok.csv", "--machine", "m.json"], b"").fails(2, "m.json (chain[0].min)");
+    w.run(BIN, &["ok.csv", "--machine", &m, "--tol", "0"], b"").fails(2, "--tol must be a positive number");
+    w.run(BIN, &["ok.csv", "--machine", &m, "--tol", "0.0000001"], b"")
+        .fails(2, "too small for the program's decimals");
+}
+
+/// LinuxCNC's own interpreter (Debian package linuxcnc-uspace, `rs274`) reads the LinuxCNC
+/// programs without error, and its canonical positions are the ones our reader gets.
+#[test]
+fn linuxcnc_interpreter_agrees() {
+    let Some(rs274) = ["/usr/bin/rs274", "/usr/local/bin/rs274"].into_iter().find(|p| std::path::Path::new(p).exists())
+    else {
+        eprintln!("rs274 not installed (scripts/install-linuxcnc.sh): LinuxCNC check skipped");
+        return;
+    };
+    let w = Work::new();
+    w.write("tool.tbl", "T1 P1 Z0 D6 ;\nT2 P2 Z0 D25 ;\nT4 P4 Z0 D10 ;\nT5 P5 Z0 D10 ;\nT6 P6 Z0 D10 ;\n");
+    let c = P3::new(0.0, 0.0, -500.0);
+    let six = sphere_scan(c, 500.0, &[-1.0, 0.0, 1.0], 20.0, 0.5, -5.0, true);
+    let cases: Vec<(&str, Vec<Row>)> = vec![
+        ("paper002-ac.json", globe(25.0)),
+        ("paper000-sixaxis-b.json", six.clone()),
+        ("paper000-sixaxis-m19.json", six),
+        ("head-bc.json", sphere_scan(P3::new(0.0, 0.0, -40.0), 60.0, &[0.0], 30.0, 1.0, 0.0, false)),
+    ];
+    for (name, rows) in cases {
+        post(&w, &rows, &machine(name), &["--tol", "0.001"], "l.ngc");
+        let out = std::process::Command::new(rs274)
+            .args(["-t", w.path("tool.tbl").to_str().unwrap(), "-g", w.path("l.ngc").to_str().unwrap()])
+            .output()
+            .expect("rs274 runs");
+        let canon = String::from_utf8_lossy(&out.stdout);
+        assert!(out.status.success(), "{name}: rs274 failed: {}", String::from_utf8_lossy(&out.stderr));
+        // STRAIGHT_TRAVERSE / STRAIGHT_FEED(x, y, z, a, b, c) in program order, and our reader's.
+        let theirs: Vec<[f64; 6]> = canon
+            .lines()
+            .filter_map(|l| {
+                let at = l.find("STRAIGHT_")?;
+                let args = &l[l[at..].find('(')? + at + 1..l.rfind(')')?];
+                let v: Vec<f64> = args.split(',').map(|x| x.trim().parse().unwrap()).collect();
+                Some([v[0], v[1], v[2], v[3], v[4], v[5]])
+            })
+            .collect();
+        let ours = camkit::gcode::read_axes("l.ngc", &w.read("l.ngc")).unwrap();
+        assert_eq!(theirs.len(), ours.moves.len(), "{name}: number of moves");
+        let mut compared = 0;
+        for (t, m) in theirs.iter().zip(&ours.moves) {
+            if m.machine_coords {
+                continue;
+            }
+            for k in 0..6 {
+                if m.known[k] {
+                    assert!(
+                        (t[k] - m.pos[k]).abs() <= 0.5e-4 + 1e-9,
+                        "{name}: line {} axis {k}: {} vs {}",
+                        m.line,
+                        t[k],
+                        m.pos[k]
+                    );
+                }
+            }
+            compared += 1;
+        }
+        assert!(compared > rows.len() / 2, "{name}: {compared} moves compared");
+        if name.contains("m19") {
+            assert!(canon.contains("ORIENT_SPINDLE"), "{name}: M19 reaches the canon");
+        }
+    }
+}
