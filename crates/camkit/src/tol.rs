@@ -31,6 +31,10 @@ pub const OFFSET_TOL: f64 = 1e-6;
 /// cleaned input; the result is still verified against the original.
 pub const CLEAN_EPS: f64 = 1e-9;
 
+/// Largest difference (mm) between an input arc's start and end radius about its centre that a
+/// reader accepts; the arc is then taken through both ends with its sweep.
+pub const ARC_END_MISMATCH: f64 = 1e-3;
+
 /// `a` and `b` differ by at most `eps`.
 pub fn near(a: f64, b: f64, eps: f64) -> bool {
     (a - b).abs() <= eps

@@ -1,0 +1,273 @@
+//! 3D mode (paper 002 §4.3, fig. 4): a 3D contour with a tool axis on every row, cut on its side
+//! by a flat end mill. At each row the contour around it (a look-ahead window along the contour)
+//! is projected onto the plane through the row perpendicular to the tool axis, offset there by
+//! R, and the offset point is mapped back into space in that plane.
+//!
+//! Where the corner offset of a row (the meeting point of its two neighbouring pieces' offsets)
+//! clears the window by R it is the row's point; a convex corner that would leave more than
+//! `chord_tol` beyond R gets several points of a polygon around the corner arc (never inside
+//! it, so no chord cuts the corner); where the window comes closer (a tight concave stretch or a
+//! neck), the point is taken from the verified 2D offset of the window.
+
+use camkit::contour::offset::Side;
+use camkit::contour::{Contour, OffsetOptions, offset_contour};
+use camkit::geom::{P2, P3, V2, V3, cross2};
+use rayon::prelude::*;
+
+/// Settings of the 3D mode.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Options {
+    /// Tool radius R (mm).
+    pub radius: f64,
+    /// Side of travel, seen from the tool (looking down the axis at the work).
+    pub side: Side,
+    /// Look-ahead: contour length (mm) taken on each side of a row.
+    pub window: f64,
+    /// Largest distance beyond R that a corner point may lie (mm).
+    pub chord_tol: f64,
+    /// Verification of the 2D offsets.
+    pub offset: OffsetOptions,
+}
+
+/// One output point: where, and which input row it belongs to.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Point {
+    /// Tool tip.
+    pub p: P3,
+    /// Index of the input row.
+    pub row: usize,
+}
+
+/// The offset contour and its figures.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Offset3 {
+    /// Points in order.
+    pub points: Vec<Point>,
+    /// Largest shortfall of an output point's distance from its window below R, in its plane (mm).
+    pub below: f64,
+    /// Largest distance of an output point from its window beyond R (mm).
+    pub above: f64,
+    /// Corners that got more than one point.
+    pub rounded: usize,
+    /// Rows whose point came from a 2D offset of the window (loops removed).
+    pub trimmed: usize,
+    /// Output points dropped because they repeated the one before.
+    pub merged: usize,
+}
+
+/// Why a row has no offset point.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Error3 {
+    /// The contour runs along the tool axis at this row.
+    AlongAxis(usize),
+    /// The contour turns back on itself at this row.
+    Reversal(usize),
+    /// The 2D offset at this row failed verification or left nothing.
+    Offset(usize, String),
+}
+
+/// The plane through `p` perpendicular to `axis`: in-plane coordinates with u along the
+/// projected travel direction `t`, v = axis × u.
+struct Frame {
+    o: P3,
+    u: V3,
+    v: V3,
+}
+
+impl Frame {
+    fn new(o: P3, axis: &V3, t: &V3) -> Option<Frame> {
+        let a = axis.normalize();
+        let u = (t - a * t.dot(&a)).try_normalize(1e-12)?;
+        Some(Frame { o, u, v: a.cross(&u) })
+    }
+
+    fn flat(&self, p: &P3) -> P2 {
+        let d = p - self.o;
+        P2::new(d.dot(&self.u), d.dot(&self.v))
+    }
+
+    fn lift(&self, q: &P2) -> P3 {
+        self.o + self.u * q.x + self.v * q.y
+    }
+}
+
+/// Indices of the window around row `i`: up to `w` mm of contour each way (the whole contour if
+/// it is shorter), in order, and whether that is the whole closed contour.
+fn window(pts: &[P3], closed: bool, i: usize, w: f64) -> (Vec<usize>, bool) {
+    let n = pts.len();
+    let step = |k: usize, fwd: bool| -> Option<usize> {
+        match (fwd, closed) {
+            (true, _) if k + 1 < n => Some(k + 1),
+            (true, true) => Some(0),
+            (false, _) if k > 0 => Some(k - 1),
+            (false, true) => Some(n - 1),
+            _ => None,
+        }
+    };
+    let mut back = Vec::new();
+    let (mut k, mut len) = (i, 0.0);
+    while let Some(j) = step(k, false) {
+        len += (pts[k] - pts[j]).norm();
+        if len > w || j == i || back.len() + 1 >= n {
+            break;
+        }
+        back.push(j);
+        k = j;
+    }
+    let mut fwd = Vec::new();
+    let (mut k, mut len) = (i, 0.0);
+    while let Some(j) = step(k, true) {
+        len += (pts[k] - pts[j]).norm();
+        if len > w || j == i || back.len() + fwd.len() + 2 > n || back.contains(&j) {
+            break;
+        }
+        fwd.push(j);
+        k = j;
+    }
+    let whole = closed && back.len() + fwd.len() + 1 == n;
+    let mut out: Vec<usize> = back.into_iter().rev().collect();
+    out.push(i);
+    out.extend(fwd);
+    (out, whole)
+}
+
+/// Distance from `q` to the polyline `poly` (closed if `closed`).
+fn poly_distance(q: &P2, poly: &[P2], closed: bool) -> f64 {
+    let mut d = camkit::geom::dist::point_polyline(q, poly);
+    if closed && poly.len() > 2 {
+        d = d.min(camkit::geom::dist::point_segment(q, &poly[poly.len() - 1], &poly[0]));
+    }
+    d
+}
+
+/// Offsets a 3D contour (points with a tool axis each).
+pub fn offset(pts: &[P3], axes: &[V3], closed: bool, opts: &Options) -> Result<Offset3, Error3> {
+    let n = pts.len();
+    let r = opts.radius;
+    let s = opts.side.sign();
+    let mut out = Offset3::default();
+    let (mut worst_above, mut worst_below) = (0.0f64, f64::INFINITY);
+    let per_row: Vec<Result<RowOffset, Error3>> = (0..n)
+        .into_par_iter()
+        .map(|i| {
+            let prev = if i > 0 {
+                Some(i - 1)
+            } else if closed {
+                Some(n - 1)
+            } else {
+                None
+            };
+            let next = if i + 1 < n {
+                Some(i + 1)
+            } else if closed {
+                Some(0)
+            } else {
+                None
+            };
+            let t = pts[next.unwrap_or(i)] - pts[prev.unwrap_or(i)];
+            let frame = Frame::new(pts[i], &axes[i], &t).ok_or(Error3::AlongAxis(i))?;
+            let (idx, whole) = window(pts, closed, i, opts.window);
+            let poly: Vec<P2> = idx.iter().map(|&j| frame.flat(&pts[j])).collect();
+            let at = idx.iter().position(|&j| j == i).expect("the row is in its window");
+            let dir = |a: &P2, b: &P2| (b - a).try_normalize(1e-15);
+            let din = if at > 0 { dir(&poly[at - 1], &poly[at]) } else { None };
+            let dout = if at + 1 < poly.len() { dir(&poly[at], &poly[at + 1]) } else { None };
+            let din = din.or(dout).ok_or(Error3::AlongAxis(i))?;
+            let dout = dout.unwrap_or(din);
+            let left = |d: &V2| V2::new(-d.y, d.x);
+            let (n_in, n_out) = (left(&din) * s, left(&dout) * s);
+            let bis = (n_in + n_out).try_normalize(1e-9).ok_or(Error3::Reversal(i))?;
+            let half = 0.5 * n_in.angle(&n_out);
+            let convex = s * cross2(&din, &dout) < 0.0;
+            let mut points = Vec::new();
+            let corner = r / half.cos();
+            if convex && corner - r > opts.chord_tol {
+                // A polygon around the corner arc, its vertices at most chord_tol beyond R.
+                let step = 2.0 * (r / (r + opts.chord_tol)).acos();
+                let m = ((2.0 * half / step).ceil() as usize).max(1);
+                let delta = 2.0 * half / m as f64;
+                let turn = if cross2(&n_in, &n_out) >= 0.0 { 1.0 } else { -1.0 };
+                for k in 0..m {
+                    let phi = turn * (k as f64 + 0.5) * delta;
+                    let (c, sn) = (phi.cos(), phi.sin());
+                    let d = V2::new(n_in.x * c - n_in.y * sn, n_in.x * sn + n_in.y * c);
+                    points.push(P2::origin() + d * (r / (0.5 * delta).cos()));
+                }
+            } else {
+                points.push(P2::origin() + bis * corner);
+            }
+            let clear = points.iter().all(|q| poly_distance(q, &poly, whole) >= r - 1e-9 * r.max(1.0));
+            let mut trimmed = false;
+            if !clear {
+                // Loops to remove: the verified offset of the window, nearest its corner point.
+                let c = Contour::polygon(&poly, whole);
+                let off =
+                    offset_contour(&c, r, opts.side, &opts.offset).map_err(|e| Error3::Offset(i, e.to_string()))?;
+                let target = P2::origin() + bis * r;
+                let best = off
+                    .contours
+                    .iter()
+                    .flat_map(|c| c.segs().collect::<Vec<_>>())
+                    .map(|seg| nearest_on(&seg, &target))
+                    .min_by(|a, b| (a - target).norm().total_cmp(&(b - target).norm()))
+                    .ok_or_else(|| {
+                        Error3::Offset(i, "the window's offset is empty: the tool does not fit here".into())
+                    })?;
+                points = vec![best];
+                trimmed = true;
+            }
+            let gaps: Vec<f64> = points.iter().map(|q| poly_distance(q, &poly, whole) - r).collect();
+            let above = gaps.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+            let below = gaps.iter().copied().fold(f64::INFINITY, f64::min);
+            Ok(RowOffset { points, frame, trimmed, above, below })
+        })
+        .collect();
+    for (i, row) in per_row.into_iter().enumerate() {
+        let RowOffset { points, frame, trimmed, above, below } = row?;
+        out.rounded += usize::from(points.len() > 1);
+        out.trimmed += usize::from(trimmed);
+        worst_above = worst_above.max(above);
+        worst_below = worst_below.min(below);
+        for q in &points {
+            let p = frame.lift(q);
+            if out.points.last().is_some_and(|l| (l.p - p).norm() <= camkit::tol::POINT_EPS) {
+                out.merged += 1;
+                continue;
+            }
+            out.points.push(Point { p, row: i });
+        }
+    }
+    out.above = worst_above.max(0.0);
+    out.below = (-worst_below).max(0.0);
+    Ok(out)
+}
+
+/// The offset points of one row in its plane.
+struct RowOffset {
+    points: Vec<P2>,
+    frame: Frame,
+    trimmed: bool,
+    above: f64,
+    below: f64,
+}
+
+/// The point of `seg` nearest `p`.
+fn nearest_on(seg: &camkit::contour::Seg, p: &P2) -> P2 {
+    match seg {
+        camkit::contour::Seg::Line(a, b) => {
+            let d = b - a;
+            let l2 = d.norm_squared();
+            let t = if l2 > 0.0 { ((p - a).dot(&d) / l2).clamp(0.0, 1.0) } else { 0.0 };
+            a + d * t
+        }
+        camkit::contour::Seg::Arc(arc) => {
+            let phi = camkit::geom::arc::angle_of(&(p - arc.c));
+            if arc.spans(phi) {
+                arc.point_at(phi)
+            } else {
+                let (s, e) = (arc.start_point(), arc.end_point());
+                if (s - p).norm() <= (e - p).norm() { s } else { e }
+            }
+        }
+    }
+}
