@@ -216,3 +216,88 @@ pub fn check_text(text: &[u8], rows: &[Cl], machine: &Machine, chain: &Chain) ->
     let poses = readback::poses(&program, &reading);
     Ok(readback::verify(rows, &poses, &reading, CHECK_SAMPLES, 1.0))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use camkit::geom::{P3, V3};
+    use proptest::prelude::*;
+
+    fn machine(name: &str) -> (Machine, Chain) {
+        let path = format!("{}/../../data/post-6axis/{name}", env!("CARGO_MANIFEST_DIR"));
+        Machine::read(&path).expect("machine document")
+    }
+
+    /// A smooth pass: the tip on a wavy curve, the axis tilting and turning along it.
+    fn pass(n: usize, tilt: f64, turn: f64, wave: f64, with_s: bool) -> Vec<Cl> {
+        (0..n)
+            .map(|k| {
+                let t = k as f64 / (n - 1) as f64;
+                let tip = P3::new(-20.0 + 40.0 * t, 10.0 * (wave * t).sin(), 5.0 * (2.0 * wave * t).cos());
+                let (th, ph) = ((tilt * (0.3 + 0.7 * t)).to_radians(), (turn * t).to_radians());
+                let axis = V3::new(th.sin() * ph.cos(), th.sin() * ph.sin(), th.cos());
+                let s = with_s.then_some(90.0 * t);
+                Cl { tip, axis, s, feed: Some(600.0), rapid: k == 0, line: k as u64 + 2 }
+            })
+            .collect()
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig { cases: 24, ..ProptestConfig::default() })]
+
+        /// Whatever the path, a program that is delivered reads back within the tolerances, by the
+        /// post's own check and by a four times denser one.
+        #[test]
+        fn delivered_programs_read_back_within_tolerance(
+            tilt in 0.0f64..60.0, turn in -200.0f64..200.0, wave in 0.0f64..6.0, which in 0usize..6,
+        ) {
+            let names = ["paper002-ac.json", "paper002-ac-fanuc-tcp.json", "paper000-sixaxis-b.json", "paper000-sixaxis-m19.json", "head-bc.json", "head-table-cb.json"];
+            let (m, chain) = machine(names[which]);
+            let rows = pass(60, tilt, turn, wave, m.spindle.is_some());
+            let s = Settings { tol: 0.002, ..Settings::default() };
+            let posted = post(&rows, "t", &m, &chain, &s, vec![]).expect("posts");
+            prop_assert!(posted.check.tip <= 0.002 && posted.check.coverage <= 0.002, "{:?}", posted.check);
+            let text = std::str::from_utf8(&posted.text).unwrap();
+            let program = read_axes("t", text).unwrap();
+            let reading = readback::Reading::new(&m, &chain);
+            let dense = readback::verify(&rows, &readback::poses(&program, &reading), &reading, 4 * CHECK_SAMPLES, 1.0);
+            prop_assert!(dense.tip <= 0.002 * (1.0 + 1e-9), "dense check {:?}", dense);
+            prop_assert!(dense.axis_deg <= 0.05 + 2.0 * posted.plan.pose_axis_error.to_degrees() + 1e-9, "{:?}", dense);
+        }
+    }
+
+    #[test]
+    fn arcs_and_slerp() {
+        let (a, b) = (V3::x(), V3::y());
+        let mid = plan::slerp(&a, &b, 0.5);
+        assert!((mid - V3::new(1.0, 1.0, 0.0).normalize()).norm() < 1e-15);
+        assert!(plan::vector_arc(&mid, &a, &b) < 1e-15);
+        // Above the arc's plane by 0.1 rad, inside its wedge; beyond its end, the angle to the end.
+        let up = (mid + V3::z() * 0.1f64.tan()).normalize();
+        assert!((plan::vector_arc(&up, &a, &b) - 0.1).abs() < 1e-12);
+        let beyond = V3::new(-1.0, 1.0, 0.0).normalize();
+        assert!((plan::vector_arc(&beyond, &a, &b) - std::f64::consts::FRAC_PI_4).abs() < 1e-12);
+    }
+
+    #[test]
+    fn inverse_time_feed_is_the_tip_path_over_the_feed() {
+        let (m, chain) = machine("paper002-ac.json");
+        let rows = pass(30, 30.0, 90.0, 1.0, false);
+        let posted = post(&rows, "t", &m, &chain, &Settings::default(), vec![]).expect("posts");
+        let text = String::from_utf8(posted.text).unwrap();
+        let program = read_axes("t", &text).unwrap();
+        let reading = readback::Reading::new(&m, &chain);
+        let table = readback::reverse(&readback::poses(&program, &reading), &reading);
+        // Every G93 block's F times its tip chord gives back the 600 mm/min of the rows.
+        let mut seen = 0;
+        for (mv, row) in program.moves.iter().zip(&table.rows) {
+            if mv.inverse_time && mv.motion == camkit::gcode::Motion::Line {
+                let f = row.f.expect("feed");
+                // To 0.1 %: the chord is measured on the rounded positions read back.
+                assert!((f - 600.0).abs() < 600.0 * 1e-3, "line {}: {f}", mv.line);
+                seen += 1;
+            }
+        }
+        assert!(seen > 20, "{seen} inverse-time blocks");
+    }
+}
