@@ -74,6 +74,36 @@ enum Mark {
         size_px: f64,
         colour: String,
     },
+    Raster(Raster),
+}
+
+/// A colour map of values on a regular grid (a height map), drawn as cells.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Raster {
+    /// World position of the lower-left corner of cell (0, 0).
+    pub origin: P2,
+    /// Cell size in world units (x, y).
+    pub cell: (f64, f64),
+    /// Cells along x.
+    pub nx: usize,
+    /// Cells along y.
+    pub ny: usize,
+    /// Values, row-major from the bottom row (`values[j * nx + i]`); NaN cells are not drawn.
+    pub values: Vec<f64>,
+    /// Values mapped to the ends of the colour ramp.
+    pub range: (f64, f64),
+}
+
+/// Colour of `t` in [0, 1] on a perceptual ramp (dark blue, teal, green, yellow).
+pub fn ramp(t: f64) -> (u8, u8, u8) {
+    const STOPS: [(f64, f64, f64); 5] =
+        [(68.0, 1.0, 84.0), (59.0, 82.0, 139.0), (33.0, 145.0, 140.0), (94.0, 201.0, 98.0), (253.0, 231.0, 37.0)];
+    let t = if t.is_finite() { t.clamp(0.0, 1.0) } else { 0.0 } * (STOPS.len() - 1) as f64;
+    let k = (t.floor() as usize).min(STOPS.len() - 2);
+    let f = t - k as f64;
+    let (a, b) = (STOPS[k], STOPS[k + 1]);
+    let mix = |p: f64, q: f64| (p + (q - p) * f).round() as u8;
+    (mix(a.0, b.0), mix(a.1, b.1), mix(a.2, b.2))
 }
 
 /// One piece of a path.
@@ -192,6 +222,18 @@ impl Plot {
     /// Text at a world position.
     pub fn label(&mut self, at: P2, text: &str, size_px: f64, colour: &str) -> &mut Self {
         self.marks.push(Mark::Label { at, text: text.into(), size_px, colour: colour.into() });
+        self
+    }
+
+    /// A colour map of grid values (see [`Raster`]); runs of equal colour along a row are drawn
+    /// as one rectangle, so keep the grid to a few hundred cells a side.
+    pub fn raster(&mut self, raster: Raster) -> &mut Self {
+        self.grow(&raster.origin);
+        self.grow(&P2::new(
+            raster.origin.x + raster.cell.0 * raster.nx as f64,
+            raster.origin.y + raster.cell.1 * raster.ny as f64,
+        ));
+        self.marks.push(Mark::Raster(raster));
         self
     }
 
@@ -321,6 +363,42 @@ impl Plot {
                         style.attrs()
                     );
                 }
+                Mark::Raster(r) => {
+                    let span = r.range.1 - r.range.0;
+                    let level = |v: f64| -> Option<u32> {
+                        v.is_finite().then(|| {
+                            let t = if span > 0.0 { (v - r.range.0) / span } else { 0.5 };
+                            (t.clamp(0.0, 1.0) * 255.0).round() as u32
+                        })
+                    };
+                    let _ = writeln!(s, r#"<g shape-rendering="crispEdges">"#);
+                    for j in 0..r.ny {
+                        let (y0, y1) = (r.origin.y + r.cell.1 * j as f64, r.origin.y + r.cell.1 * (j + 1) as f64);
+                        let mut i = 0;
+                        while i < r.nx {
+                            let Some(l) = level(r.values[j * r.nx + i]) else {
+                                i += 1;
+                                continue;
+                            };
+                            let mut e = i + 1;
+                            while e < r.nx && level(r.values[j * r.nx + e]) == Some(l) {
+                                e += 1;
+                            }
+                            let (x0, x1) = (r.origin.x + r.cell.0 * i as f64, r.origin.x + r.cell.0 * e as f64);
+                            let (cr, cg, cb) = ramp(l as f64 / 255.0);
+                            let _ = writeln!(
+                                s,
+                                r##"<rect x="{:.3}" y="{:.3}" width="{:.3}" height="{:.3}" fill="#{cr:02x}{cg:02x}{cb:02x}"/>"##,
+                                tx(x0),
+                                ty(y1),
+                                tx(x1) - tx(x0),
+                                ty(y0) - ty(y1)
+                            );
+                            i = e;
+                        }
+                    }
+                    let _ = writeln!(s, "</g>");
+                }
                 Mark::Label { at, text, size_px, colour } => {
                     let _ = writeln!(
                         s,
@@ -411,6 +489,18 @@ mod tests {
         assert!(svg.starts_with("<svg") && svg.ends_with("</svg>\n"));
         assert!(svg.contains("A") && svg.contains("t &lt;1&gt;"));
         assert_eq!(svg.matches("<svg").count(), 1);
+    }
+
+    #[test]
+    fn raster_merges_runs_and_skips_nan() {
+        let mut p = Plot::new("map", Aspect::Equal);
+        let values = vec![0.0, 0.0, 1.0, f64::NAN, 0.5, 0.5];
+        p.raster(Raster { origin: P2::new(0.0, 0.0), cell: (1.0, 1.0), nx: 3, ny: 2, values, range: (0.0, 1.0) });
+        let svg = p.to_svg(300.0);
+        // Row 0: two runs; row 1: the NaN is skipped and the two 0.5 cells merge.
+        assert_eq!(svg.matches("fill=\"#").count(), 3, "{svg}");
+        assert_eq!(ramp(0.0), (68, 1, 84));
+        assert_eq!(ramp(1.0), (253, 231, 37));
     }
 
     #[test]
