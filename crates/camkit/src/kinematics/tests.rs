@@ -255,3 +255,50 @@ fn wrap_policies() {
     let s = Solver { chain: &chain, policy: Policy::Positive, cone: 0.0 };
     assert!((s.unwind(0, 340.0, 350.0).unwrap() - 700.0).abs() < 1e-9);
 }
+
+/// LinuxCNC's `xyzac-trt` kinematics (trtfuncs, its forward and inverse formulas written out from
+/// the equations): the same machine as a chain `[C sense −1, offset (0, dy, dz), A sense −1,
+/// offset −(rot point + (0, dy, dz)), linear]` with frame = rot point. Our forward must equal
+/// theirs, and their inverse must undo our forward (a round trip, not trust).
+#[test]
+fn linuxcnc_xyzac_trt_cross_check() {
+    let (xr, yr, zr, dy, dz) = (3.5, -2.25, 41.0, 0.75, -12.5);
+    let chain = Chain::new(
+        vec![
+            Link::Rotary(0),
+            Link::Offset(V3::new(0.0, dy, dz)),
+            Link::Rotary(1),
+            Link::Offset(-V3::new(xr, yr + dy, zr + dz)),
+            Link::Linear,
+        ],
+        vec![rotary('C', V3::z(), -1.0), rotary('A', V3::x(), -1.0)],
+    )
+    .unwrap()
+    .with_frame(V3::new(xr, yr, zr));
+    let mut worst: f64 = 0.0;
+    for k in 0..200 {
+        let t = k as f64;
+        let (jx, jy, jz) = (40.0 * (t * 0.37).sin(), 30.0 * (t * 0.71).cos(), -20.0 + 15.0 * (t * 0.13).sin());
+        let (a, c) = (100.0 * (t * 0.29).sin(), 170.0 * (t * 0.53).cos());
+        let (sa, ca) = a.to_radians().sin_cos();
+        let (sc, cc) = c.to_radians().sin_cos();
+        let (vx, vy, vz) = (jx - xr, jy - dy - yr, jz - dz - zr);
+        let theirs = V3::new(
+            cc * vx + sc * ca * vy + sc * sa * vz + sc * dy + xr,
+            -sc * vx + cc * ca * vy + cc * sa * vz + cc * dy + yr,
+            -sa * vy + ca * vz + dz + zr,
+        );
+        let ours = chain.forward(&Joints { xyz: V3::new(jx, jy, jz), rot: [c, a] });
+        worst = worst.max((ours.tip.coords - theirs).norm());
+        // Their inverse from our world position gives the joints back.
+        let (x, y, z) = (ours.tip.x - xr, ours.tip.y - yr, ours.tip.z - zr);
+        let back = V3::new(
+            cc * x - sc * y + xr,
+            sc * ca * x + cc * ca * y - sa * z - ca * dy + sa * dz + dy + yr,
+            sc * sa * x + cc * sa * y + ca * z - sa * dy - ca * dz + dz + zr,
+        );
+        assert!((back - V3::new(jx, jy, jz)).norm() < 1e-9, "their inverse does not undo the forward: {back:?}");
+        assert!((chain.linear_for(&ours.tip, &[c, a]) - V3::new(jx, jy, jz)).norm() < 1e-9);
+    }
+    assert!(worst < 1e-9, "our forward differs from LinuxCNC's xyzac-trt by {worst} mm");
+}
