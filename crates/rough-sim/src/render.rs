@@ -1,0 +1,83 @@
+//! Height maps and figures written out: CSV (x, y, height), an SVG colour map, and profile and
+//! sweep plots.
+
+use crate::patch::HeightMap;
+use camkit::geom::P2;
+use camkit::svg::{Aspect, Plot, Raster, Style};
+use std::fmt::Write;
+
+/// Cells along the longer side of a colour map; larger maps are sampled down to this.
+const MAP_CELLS: usize = 300;
+
+/// The map as CSV: `x,y,<name>` in mm, one node per row, rows of constant y in order; NaN nodes
+/// (never cut) are written with an empty height.
+pub fn csv(map: &HeightMap, name: &str) -> Vec<u8> {
+    let g = &map.grid;
+    let mut out = String::with_capacity(g.nx * g.ny * 28 + 16);
+    let _ = writeln!(out, "x,y,{name}");
+    for j in 0..g.ny {
+        for i in 0..g.nx {
+            let v = map.at(i, j);
+            if v.is_finite() {
+                let _ = writeln!(out, "{:.6},{:.6},{:.7}", g.x(i), g.y(j), v);
+            } else {
+                let _ = writeln!(out, "{:.6},{:.6},", g.x(i), g.y(j));
+            }
+        }
+    }
+    out.into_bytes()
+}
+
+/// An SVG colour map of the heights (in µm above `zero`), sampled down to at most
+/// [`MAP_CELLS`] a side by taking each cell's highest node (peaks stay visible).
+pub fn colour_map(map: &HeightMap, title: &str, zero: f64) -> String {
+    let g = &map.grid;
+    let k = g.nx.max(g.ny).div_ceil(MAP_CELLS).max(1);
+    let (nx, ny) = (g.nx.div_ceil(k), g.ny.div_ceil(k));
+    let mut values = vec![f64::NAN; nx * ny];
+    for i in 0..g.nx {
+        for j in 0..g.ny {
+            let v = (map.at(i, j) - zero) * 1e3;
+            let cell = &mut values[(j / k) * nx + i / k];
+            if v.is_finite() && !(cell.is_finite() && *cell >= v) {
+                *cell = v;
+            }
+        }
+    }
+    let (lo, hi) = values
+        .iter()
+        .filter(|v| v.is_finite())
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |a, &v| (a.0.min(v), a.1.max(v)));
+    let range = if lo.is_finite() { (lo, hi) } else { (0.0, 1.0) };
+    let cell = (g.step * k as f64, g.step * k as f64);
+    let mut p = Plot::new(&format!("{title} (height {:.2} to {:.2} µm)", range.0, range.1), Aspect::Equal);
+    p.labels("x (mm)", "y (mm)");
+    let origin = P2::new(g.x0 - cell.0 / 2.0, g.y0 - cell.1 / 2.0);
+    p.raster(Raster { origin, cell, nx, ny, values, range });
+    // Colour bar: eleven swatches from low to high.
+    for s in 0..=10 {
+        let t = s as f64 / 10.0;
+        let (r, gg, b) = camkit::svg::ramp(t);
+        p.legend(
+            &format!("{:.2} µm", range.0 + t * (range.1 - range.0)),
+            Style::fill(&format!("#{r:02x}{gg:02x}{b:02x}"), 1.0),
+        );
+    }
+    p.to_svg(900.0)
+}
+
+/// A chart of series of (x, y) points with a legend.
+pub fn chart(title: &str, x_label: &str, y_label: &str, series: &[(String, Vec<(f64, f64)>)]) -> String {
+    const COLOURS: [&str; 6] = ["#1f77b4", "#d62728", "#2ca02c", "#9467bd", "#ff7f0e", "#8c564b"];
+    let mut p = Plot::new(title, Aspect::Free);
+    p.labels(x_label, y_label);
+    p.include(P2::new(series.iter().flat_map(|s| s.1.iter().map(|q| q.0)).fold(f64::INFINITY, f64::min), 0.0));
+    for (k, (name, pts)) in series.iter().enumerate() {
+        let pts: Vec<P2> = pts.iter().filter(|q| q.1.is_finite()).map(|q| P2::new(q.0, q.1)).collect();
+        let style = Style::stroke(COLOURS[k % COLOURS.len()], 1.8);
+        p.polyline(&pts, style.clone());
+        p.dots(&pts, 2.5, Style::fill(COLOURS[k % COLOURS.len()], 1.0));
+        p.legend(name, style);
+    }
+    p.to_svg(800.0)
+}

@@ -1,0 +1,89 @@
+//! One periodic cell of the paper's surface and its figures, and sweeps of them against feed
+//! per tooth, tilt and spindle speed (paper 003 fig. 4b, fig. 5b, §3.2).
+
+use crate::figures::{Figures, classic_peak, cusp_classic, cusp_exact, figures};
+use crate::patch::{Conditions, Grid, HeightMap, simulate};
+
+/// Heights above the classic peak by less than this (mm) are not called a remainder: the
+/// solver's and grid's error stays well below it.
+pub const REMAINDER_MARGIN: f64 = 1e-4;
+
+/// The figures of one cutting condition.
+#[derive(Clone, Debug, PartialEq)]
+pub struct CellFigures {
+    /// Classic cusp f²/8r (mm).
+    pub cusp_classic: f64,
+    /// Exact cusp of two spheres (mm).
+    pub cusp_exact: f64,
+    /// Peak of the classic surface, cusp and feed scallop added (mm).
+    pub classic_peak: f64,
+    /// The simulated map's figures.
+    pub map: Figures,
+    /// Height of the uncut remainder: the surface's highest point if it rises above the classic
+    /// peak, else 0 (mm).
+    pub remainder: f64,
+}
+
+/// The grid of one periodic cell: one pick feed across the pass at x = 0, one feed per tooth
+/// along it (the surface repeats with both).
+pub fn cell_grid(cond: &Conditions, step: f64) -> Grid {
+    Grid::covering(-cond.pick / 2.0, cond.pick / 2.0, 0.0, cond.feed_per_tooth, step)
+}
+
+/// Simulates one cell and takes its figures.
+pub fn cell(cond: &Conditions, step: f64) -> (HeightMap, CellFigures) {
+    let map = simulate(cond, &cell_grid(cond, step));
+    let figs = cell_figures(cond, &map);
+    (map, figs)
+}
+
+/// Figures of a simulated map of `cond`.
+pub fn cell_figures(cond: &Conditions, map: &HeightMap) -> CellFigures {
+    let r = cond.cutter.radius;
+    let f = figures(map, cond.pick, cond.cutter.rotation.sign() > 0.0);
+    let classic = classic_peak(r, cond.pick, cond.feed_per_tooth);
+    let remainder = if f.max_height > classic + REMAINDER_MARGIN { f.max_height } else { 0.0 };
+    CellFigures {
+        cusp_classic: cusp_classic(r, cond.pick),
+        cusp_exact: cusp_exact(r, cond.pick),
+        classic_peak: classic,
+        map: f,
+        remainder,
+    }
+}
+
+/// The header of a figures table row.
+pub const HEADER: &str = "radius,flutes,pick,feed_per_tooth,tilt_deg,pass_phase_deg,spindle_rpm,cusp_classic_um,cusp_exact_um,classic_peak_um,max_height_um,remainder_um,cross_rz_um,cross_ra_um,feed_rz_um,feed_ra_um,down_cut_max_um,up_cut_max_um,grid_error_um";
+
+/// One row of the figures table (µm) for `cond` (and a spindle speed if the sweep has one).
+pub fn row(cond: &Conditions, spindle: Option<f64>, c: &CellFigures) -> String {
+    let um = |v: f64| format!("{:.4}", v * 1e3);
+    let m = &c.map;
+    [
+        format!("{}", cond.cutter.radius),
+        format!("{}", cond.cutter.flutes),
+        format!("{}", cond.pick),
+        format!("{}", round(cond.feed_per_tooth)),
+        format!("{}", round(cond.tilt.to_degrees())),
+        format!("{}", round(cond.pass_phase.to_degrees())),
+        spindle.map_or(String::new(), |n| format!("{}", round(n))),
+        um(c.cusp_classic),
+        um(c.cusp_exact),
+        um(c.classic_peak),
+        um(m.max_height),
+        um(c.remainder),
+        um(m.cross_rz),
+        um(m.cross_ra),
+        um(m.feed_rz),
+        um(m.feed_ra),
+        um(m.down_cut_max),
+        um(m.up_cut_max),
+        um(m.peak_to_valley - m.peak_to_valley_half),
+    ]
+    .join(",")
+}
+
+/// Rounds away binary noise for printing (12 significant decimals).
+fn round(v: f64) -> f64 {
+    (v * 1e9).round() / 1e9
+}
