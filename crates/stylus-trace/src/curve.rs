@@ -123,13 +123,13 @@ impl PlaneCurve<'_> {
 impl Curve for PlaneCurve<'_> {
     fn correct(&self, guess: &P3, across: &V3) -> Option<CurvePoint> {
         let r = self.stylus.radius;
-        let w = self.plane_normal.cross(across).try_normalize(1e-12)?;
+        let mut w = self.plane_normal.cross(across).try_normalize(1e-12)?;
         let mut c = *guess;
         // |L| is 1-Lipschitz: after a move of m, the nearest point is at most |L| + m away, a
         // bound that lets the model's index prune from the start.
         let mut bound = f64::INFINITY;
         for it in 1..=MAX_NEWTON {
-            let Some(n) = self.model.nearest_within(&c, bound) else { return None };
+            let n = self.model.nearest_within(&c, bound)?;
             if !n.converged {
                 return None;
             }
@@ -137,9 +137,18 @@ impl Curve for PlaneCurve<'_> {
             if delta.abs() <= self.stylus.target() {
                 return self.finish(c, &n, it);
             }
-            let slope = n.direction(&c).dot(&w);
+            let u = n.direction(&c);
+            let mut slope = u.dot(&w);
             if slope.abs() < MIN_SLOPE {
-                return None;
+                // Across the step the offset surface is nearly parallel (a concave corner turning
+                // by more than ~80°): correct along ΔR's own projection on the plane instead,
+                // the copying machine's two-dimensional correction.
+                let g = u - self.plane_normal * u.dot(&self.plane_normal);
+                if g.norm() < MIN_SLOPE {
+                    return None;
+                }
+                w = g.normalize();
+                slope = u.dot(&w);
             }
             let moved = delta / slope;
             c += w * moved;

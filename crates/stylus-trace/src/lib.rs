@@ -56,6 +56,9 @@ pub struct TracedPath {
     pub points: Vec<ClPoint>,
     /// Largest estimated chord deviation of its steps (mm).
     pub deviation: f64,
+    /// True when the pass ended because the stylus could not follow the model any further
+    /// (scan mode: it slid off the side of a sheet); the next pass starts beyond.
+    pub interrupted: bool,
 }
 
 /// What to trace.

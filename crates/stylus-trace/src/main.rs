@@ -280,6 +280,12 @@ fn run(args: Args) -> Result<()> {
     let verified = stylus_trace::verify(&model, &opts.stylus, &paths, two).map_err(|rej| {
         Error::check(format!("CL point in row {} (line {} of the output): {}", rej.row + 1, rej.row + 2, rej.what))
     })?;
+    let interrupted = paths.iter().filter(|p| p.interrupted).count();
+    if interrupted > 0 {
+        cli::warn(&format!(
+            "{interrupted} passes end where the stylus could not follow the model (off the side of a sheet); the next pass starts beyond"
+        ));
+    }
     let tag = opts.mode.tag();
     let t = output::table(&model, &paths, tag, two.is_some());
     let mut out = Output::new(args.io.output.as_deref());
@@ -307,6 +313,7 @@ fn run(args: Args) -> Result<()> {
             .set("triangles", model.triangles())
             .set("units", opts.mode.units())
             .set("paths", paths.len())
+            .set("interrupted_passes", interrupted)
             .set("points", verified.points)
             .set(
                 "newton_iterations_mean",

@@ -44,8 +44,9 @@ impl Line {
     }
 }
 
-/// The scan lines covering the region: the region's corners projected on the direction give the
-/// extent along it; lines are spaced by the pick feed across it, starting on the region's edge.
+/// The scan lines covering the region: lines along the direction, spaced by the pick feed across
+/// it from the region's edge, each clipped to the region (lines that only graze a corner are
+/// dropped).
 pub fn lines(scan: &Scan) -> Vec<Line> {
     let (s, c) = scan.angle.to_radians().sin_cos();
     let d = V3::new(c, s, 0.0);
@@ -53,25 +54,35 @@ pub fn lines(scan: &Scan) -> Vec<Line> {
     let r = &scan.region;
     let corners =
         [P3::new(r.x0, r.y0, 0.0), P3::new(r.x1, r.y0, 0.0), P3::new(r.x0, r.y1, 0.0), P3::new(r.x1, r.y1, 0.0)];
-    let along = |p: &P3| p.coords.dot(&d);
     let side = |p: &P3| p.coords.dot(&across);
-    let (mut s0, mut s1, mut v0, mut v1) = (f64::INFINITY, -f64::INFINITY, f64::INFINITY, -f64::INFINITY);
-    for p in &corners {
-        (s0, s1, v0, v1) = (s0.min(along(p)), s1.max(along(p)), v0.min(side(p)), v1.max(side(p)));
-    }
+    let (v0, v1) = corners.iter().fold((f64::INFINITY, -f64::INFINITY), |(a, b), p| (a.min(side(p)), b.max(side(p))));
     let n = ((v1 - v0) / scan.pick + 1e-9).floor() as usize;
-    (0..=n)
-        .map(|k| {
-            let v = v0 + k as f64 * scan.pick;
-            let backward = scan.zigzag && k % 2 == 1;
-            let dir = if backward { -d } else { d };
-            let origin = P3::from(across * v);
-            if backward { Line { origin, dir, s0: -s1, s1: -s0 } } else { Line { origin, dir, s0, s1 } }
-        })
-        .collect()
+    let mut out = Vec::new();
+    for k in 0..=n {
+        let origin = P3::from(across * (v0 + k as f64 * scan.pick));
+        // Slab clipping of origin + s·d against the rectangle.
+        let (mut s0, mut s1) = (-f64::INFINITY, f64::INFINITY);
+        for (o, dd, lo, hi) in [(origin.x, d.x, r.x0, r.x1), (origin.y, d.y, r.y0, r.y1)] {
+            if dd.abs() < 1e-12 {
+                if o < lo - 1e-9 || o > hi + 1e-9 {
+                    (s0, s1) = (1.0, 0.0);
+                }
+            } else {
+                let (a, b) = ((lo - o) / dd, (hi - o) / dd);
+                (s0, s1) = (s0.max(a.min(b)), s1.min(a.max(b)));
+            }
+        }
+        if s1 - s0 <= 1e-9 {
+            continue;
+        }
+        let backward = scan.zigzag && out.len() % 2 == 1;
+        out.push(if backward { Line { origin, dir: -d, s0: -s1, s1: -s0 } } else { Line { origin, dir: d, s0, s1 } });
+    }
+    out
 }
 
-/// Traces one scan line; the passes it yields, in order.
+/// Traces one scan line; the passes it yields, in order. A pass ends at the region's end, where
+/// the model falls away (an overhang), or where the stylus cannot follow it (`interrupted`).
 pub fn trace_line(model: &Model, stylus: Stylus, steps: &Steps, line: &Line) -> Result<Vec<TracedPath>, Failure> {
     let curve = PlaneCurve { model, stylus, plane_normal: V3::z().cross(&line.dir) };
     let bounds = model.bounds();
@@ -93,6 +104,7 @@ pub fn trace_line(model: &Model, stylus: Stylus, steps: &Steps, line: &Line) -> 
         let mut h = steps.max_step * 0.25;
         let mut deviation: f64 = 0.0;
         let mut ended_at = line.s1;
+        let mut interrupted = false;
         loop {
             let a = *pts.last().expect("a pass has a start");
             let sa = line.s_of(&a.cl.centre);
@@ -105,7 +117,11 @@ pub fn trace_line(model: &Model, stylus: Stylus, steps: &Steps, line: &Line) -> 
                 break;
             }
             let Some(st) = step(&curve, &a, h, steps) else {
-                return Err(Failure { at: a.cl.centre, what: "the stylus cannot follow the model here".into() });
+                // The stylus loses the model (it slides off a sheet's side): the pass ends here
+                // and the stylus is dropped again farther on.
+                ended_at = sa;
+                interrupted = true;
+                break;
             };
             let mut next = st.to;
             if line.s_of(&next.cl.centre) > line.s1 {
@@ -123,8 +139,9 @@ pub fn trace_line(model: &Model, stylus: Stylus, steps: &Steps, line: &Line) -> 
             h = st.next;
             pts.push(next);
         }
-        paths.push(TracedPath { points: pts.into_iter().map(|p| p.cl).collect(), deviation });
-        s = if ended_at >= line.s1 { f64::INFINITY } else { ended_at + steps.min_step.max(1e-3) };
+        paths.push(TracedPath { points: pts.into_iter().map(|p| p.cl).collect(), deviation, interrupted });
+        // Always onwards: a drop's correction may have landed behind where it was dropped.
+        s = if ended_at >= line.s1 { f64::INFINITY } else { ended_at.max(s) + steps.min_step.max(1e-3) };
     }
     Ok(paths)
 }

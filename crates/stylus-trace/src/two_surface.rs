@@ -51,7 +51,11 @@ pub fn trace(model: &Model, stylus: Stylus, steps: &Steps, ts: &TwoSurface) -> R
     })?;
     let (forward, closed, dev_f) = follow(&curve, seed, steps, &ts.region, r);
     if closed {
-        return Ok(vec![TracedPath { points: forward.iter().map(|p| p.cl).collect(), deviation: dev_f }]);
+        return Ok(vec![TracedPath {
+            points: forward.iter().map(|p| p.cl).collect(),
+            deviation: dev_f,
+            interrupted: false,
+        }]);
     }
     // An open line: trace back from the seed the other way and join.
     let back_curve = TwoSurfaceCurve { model, stylus, surfaces: ts.surfaces, reverse: !ts.reverse };
@@ -62,7 +66,7 @@ pub fn trace(model: &Model, stylus: Stylus, steps: &Steps, ts: &TwoSurface) -> R
     let (backward, _, dev_b) = follow(&back_curve, back_seed, steps, &ts.region, r);
     let mut pts: Vec<_> = backward.iter().rev().map(|p| p.cl).collect();
     pts.extend(forward.iter().skip(1).map(|p| p.cl));
-    Ok(vec![TracedPath { points: pts, deviation: dev_f.max(dev_b) }])
+    Ok(vec![TracedPath { points: pts, deviation: dev_f.max(dev_b), interrupted: false }])
 }
 
 /// Steps from `seed` until the line closes, leaves the region, or the double contact is lost.
