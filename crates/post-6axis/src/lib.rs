@@ -300,4 +300,38 @@ mod tests {
         }
         assert!(seen > 20, "{seen} inverse-time blocks");
     }
+
+    /// Three full turns around a latitude circle, one pass each: C keeps turning within a pass
+    /// and is unwound at each pass start once past a full turn; inch output reads back the same.
+    #[test]
+    fn wrapping_axis_is_unwound_between_passes_and_inch_reads_back() {
+        let (mut m, chain) = machine("paper002-ac.json");
+        let mut rows = Vec::new();
+        for pass in 0..3 {
+            for k in 0..=72 {
+                let lon = (k as f64 * 5.0).to_radians();
+                let lat = 50.0f64.to_radians();
+                let axis = V3::new(lat.cos() * lon.cos(), lat.cos() * lon.sin(), lat.sin());
+                rows.push(Cl {
+                    tip: P3::from(axis * 25.0),
+                    axis,
+                    s: None,
+                    feed: Some(500.0),
+                    rapid: k == 0,
+                    line: (pass * 73 + k) as u64 + 2,
+                });
+            }
+        }
+        let posted = post(&rows, "t", &m, &chain, &Settings::default(), vec![]).expect("posts");
+        // C turns −360° per pass (sense −1): from 90° to −270°, −270° to −630°, then unwound to 90°.
+        assert_eq!(posted.plan.unwinds, 1, "{:?}", posted.plan);
+        let program = read_axes("t", std::str::from_utf8(&posted.text).unwrap()).unwrap();
+        let c_max = program.moves.iter().map(|mv| mv.pos[5].abs()).fold(0.0, f64::max);
+        assert!(c_max > 600.0 && c_max < 720.0, "C stays continuous within a pass, unwound between: {c_max}");
+        m.program.units = camkit::doc::machine::UnitsDoc::Inch;
+        m.program.decimals.linear = 5;
+        let inch = post(&rows, "t", &m, &chain, &Settings::default(), vec![]).expect("posts in inches");
+        assert!(std::str::from_utf8(&inch.text).unwrap().contains("G20 "));
+        assert!(inch.check.tip <= 0.005, "{:?}", inch.check);
+    }
 }
