@@ -59,7 +59,8 @@ pub fn push_fixed(out: &mut Vec<u8>, v: f64, decimals: u32, trim: bool) {
     let d = decimals.min(MAX_DECIMALS);
     let p = POW10[d as usize];
     let x = v * p;
-    if !(x.abs() < 4.0e15) {
+    // Too large for an exact integer (or not finite): let the standard formatter do it.
+    if x.is_nan() || x.abs() >= 4.0e15 {
         out.extend_from_slice(format!("{v:.*}", d as usize).as_bytes());
         return;
     }
