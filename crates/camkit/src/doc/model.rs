@@ -126,7 +126,8 @@ surface_kind!(
 );
 surface_kind!(
     /// A B-spline surface: `control_points[i][j]` (i along u, j along v), degrees [p, q]
-    /// (default [3, 3]), knot vectors (default clamped uniform). The normal is Su × Sv.
+    /// (default [3, 3]), knot vectors (default clamped uniform), and weights for a NURBS
+    /// surface. The normal is Su × Sv.
     BsplineDoc {
         /// Control net, rows along u.
         control_points: Vec<Vec<[f64; 3]>>,
@@ -139,6 +140,9 @@ surface_kind!(
         /// Knots in v.
         #[serde(default, skip_serializing_if = "Option::is_none")]
         knots_v: Option<Vec<f64>>,
+        /// Weights of the control points, same shape as the net (a NURBS surface); all > 0.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        weights: Option<Vec<Vec<f64>>>,
     }
 );
 surface_kind!(
@@ -316,6 +320,9 @@ impl ModelDoc {
                     }
                     check_knots(d.knots_u.as_deref(), nu, p, &at("knots_u"), file)?;
                     check_knots(d.knots_v.as_deref(), nv, q, &at("knots_v"), file)?;
+                    if let Some(w) = &d.weights {
+                        check_weights(w, nu, nv, &at("weights"), file)?;
+                    }
                 }
                 SurfaceDoc::Bezier(d) => {
                     check_net(&d.control_points, &at("control_points"), file)?;
@@ -354,6 +361,26 @@ fn check_net(net: &[Vec<[f64; 3]>], path: &str, file: &str) -> Result<()> {
         for (j, p) in row.iter().enumerate() {
             if !p.iter().all(|x| x.is_finite()) {
                 return Err(field_error(file, &format!("{path}[{i}][{j}]"), "numbers must be finite"));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Weights of a NURBS net: the net's shape, every one finite and positive (which keeps the
+/// surface inside its control points' hull).
+fn check_weights(w: &[Vec<f64>], nu: usize, nv: usize, path: &str, file: &str) -> Result<()> {
+    if w.len() != nu || w.iter().any(|row| row.len() != nv) {
+        return Err(field_error(file, path, format!("weights must have the net's shape ({nu} × {nv})")));
+    }
+    for (i, row) in w.iter().enumerate() {
+        for (j, x) in row.iter().enumerate() {
+            if !(x.is_finite() && *x > 0.0) {
+                return Err(field_error(
+                    file,
+                    &format!("{path}[{i}][{j}]"),
+                    format!("a weight must be a positive number, got {x}"),
+                ));
             }
         }
     }
@@ -436,6 +463,17 @@ mod tests {
             parse(r#"{"surfaces": [{"type": "bspline", "control_points": [[[0,0,0],[0,1,0]],[[1,0,0],[1,1,0]]]}]}"#)
                 .unwrap_err();
         assert!(e.to_string().contains("(surfaces[0].degree)"), "{e}");
+        let nurbs = |w: &str| {
+            parse(&format!(
+                r#"{{"surfaces": [{{"type": "bspline", "degree": [1, 1], "weights": {w},
+                    "control_points": [[[0,0,0],[0,1,0]],[[1,0,0],[1,1,0]]]}}]}}"#
+            ))
+        };
+        assert!(nurbs("[[1, 2], [0.5, 1]]").is_ok());
+        let e = nurbs("[[1, 2], [0, 1]]").unwrap_err();
+        assert!(e.to_string().contains("(surfaces[0].weights[1][0]): a weight must be a positive number"), "{e}");
+        let e = nurbs("[[1, 2, 3], [1, 1]]").unwrap_err();
+        assert!(e.to_string().contains("(surfaces[0].weights): weights must have the net's shape (2 × 2)"), "{e}");
         assert!(parse(r#"{"surfaces": []}"#).unwrap_err().to_string().contains("at least one surface"));
     }
 }

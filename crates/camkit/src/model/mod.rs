@@ -266,7 +266,13 @@ impl Model {
                 }),
                 SurfaceDoc::Bspline(d) => {
                     let net: Vec<Vec<P3>> = d.control_points.iter().map(|r| r.iter().map(p3).collect()).collect();
-                    Geometry::Patch(BSpline::new(&net, d.degree, d.knots_u.clone(), d.knots_v.clone()))
+                    Geometry::Patch(BSpline::with_weights(
+                        &net,
+                        d.weights.as_deref(),
+                        d.degree,
+                        d.knots_u.clone(),
+                        d.knots_v.clone(),
+                    ))
                 }
                 SurfaceDoc::Bezier(d) => {
                     let net: Vec<Vec<P3>> = d.control_points.iter().map(|r| r.iter().map(p3).collect()).collect();

@@ -1,4 +1,4 @@
-//! B-spline (and Bézier) surfaces: evaluation with derivatives and the nearest point, found by a
+//! B-spline (Bézier, NURBS) surfaces: evaluation with derivatives and the nearest point, found by a
 //! safeguarded Newton iteration on the foot-point condition started in every knot span that can
 //! hold a nearer point than the best so far (the spans' control-point hulls bound them).
 
@@ -25,6 +25,8 @@ pub struct BSpline {
     size: [usize; 2],
     /// Control points, `i * nv + j`.
     ctrl: Vec<P3>,
+    /// Weights of a NURBS surface, `i * nv + j` (None: polynomial).
+    weights: Option<Vec<f64>>,
     knots: [Vec<f64>; 2],
     /// Parameter rectangles of the spans, in the index's order: (u0, u1, v0, v1, span_u, span_v).
     spans: Vec<([f64; 4], [usize; 2])>,
@@ -155,7 +157,21 @@ impl BSpline {
     /// A surface from a rectangular net (`net[i][j]`, i along u), degrees and knots (clamped
     /// uniform when `None`). The caller has validated sizes and knots.
     pub fn new(net: &[Vec<P3>], degree: [usize; 2], knots_u: Option<Vec<f64>>, knots_v: Option<Vec<f64>>) -> BSpline {
+        BSpline::with_weights(net, None, degree, knots_u, knots_v)
+    }
+
+    /// A NURBS surface when `weights` (the net's shape, all positive) are given, else as
+    /// [`BSpline::new`]. Positive weights keep each span inside its control points' hull, which
+    /// the span index relies on.
+    pub fn with_weights(
+        net: &[Vec<P3>],
+        weights: Option<&[Vec<f64>]>,
+        degree: [usize; 2],
+        knots_u: Option<Vec<f64>>,
+        knots_v: Option<Vec<f64>>,
+    ) -> BSpline {
         let size = [net.len(), net[0].len()];
+        let weights = weights.map(|w| w.iter().flatten().copied().collect());
         let ctrl: Vec<P3> = net.iter().flatten().copied().collect();
         let knots = [
             knots_u.unwrap_or_else(|| clamped_uniform(size[0], degree[0])),
@@ -184,7 +200,7 @@ impl BSpline {
         }
         let index = Bvh::build(&boxes);
         let spans = index.order.iter().map(|&i| spans[i as usize]).collect();
-        BSpline { degree, size, ctrl, knots, spans, index }
+        BSpline { degree, size, ctrl, weights, knots, spans, index }
     }
 
     /// Parameter domain [u0, u1, v0, v1].
@@ -212,19 +228,33 @@ impl BSpline {
         let [p, q] = self.degree;
         let bu = basis_derivs(&self.knots[0], su, p, u);
         let bv = basis_derivs(&self.knots[1], sv, q, v);
+        // Homogeneous sums: A = Σ w·P·N and its derivatives, W = Σ w·N (w = 1 unless NURBS).
         let mut acc = [V3::zeros(); 6];
+        let mut wacc = [0.0f64; 6];
         for (i, ((b0, b1), b2)) in bu[0].iter().zip(&bu[1]).zip(&bu[2]).take(p + 1).enumerate() {
             for (j, ((c0, c1), c2)) in bv[0].iter().zip(&bv[1]).zip(&bv[2]).take(q + 1).enumerate() {
-                let c = self.ctrl[(su - p + i) * self.size[1] + (sv - q + j)].coords;
-                acc[0] += c * (b0 * c0);
-                acc[1] += c * (b1 * c0);
-                acc[2] += c * (b0 * c1);
-                acc[3] += c * (b2 * c0);
-                acc[4] += c * (b1 * c1);
-                acc[5] += c * (b0 * c2);
+                let k = (su - p + i) * self.size[1] + (sv - q + j);
+                let w = self.weights.as_ref().map_or(1.0, |ws| ws[k]);
+                let c = self.ctrl[k].coords * w;
+                let basis = [b0 * c0, b1 * c0, b0 * c1, b2 * c0, b1 * c1, b0 * c2];
+                for ((a, wa), b) in acc.iter_mut().zip(wacc.iter_mut()).zip(basis) {
+                    *a += c * b;
+                    *wa += w * b;
+                }
             }
         }
-        Derivs { s: P3::from(acc[0]), su: acc[1], sv: acc[2], suu: acc[3], suv: acc[4], svv: acc[5] }
+        if self.weights.is_none() {
+            return Derivs { s: P3::from(acc[0]), su: acc[1], sv: acc[2], suu: acc[3], suv: acc[4], svv: acc[5] };
+        }
+        // S = A/W and the quotient rule (The NURBS Book, eq. 4.20) up to second order.
+        let [w, wu, wv, wuu, wuv, wvv] = wacc;
+        let s = acc[0] / w;
+        let su = (acc[1] - s * wu) / w;
+        let sv = (acc[2] - s * wv) / w;
+        let suu = (acc[3] - su * (2.0 * wu) - s * wuu) / w;
+        let suv = (acc[4] - su * wv - sv * wu - s * wuv) / w;
+        let svv = (acc[5] - sv * (2.0 * wv) - s * wvv) / w;
+        Derivs { s: P3::from(s), su, sv, suu, suv, svv }
     }
 
     /// Unit normal Su × Sv at (u, v), if the surface is regular there.
@@ -372,6 +402,46 @@ mod tests {
         // A clamped B-spline interpolates its corner points.
         assert!((s.eval(0.0, 0.0).s - P3::new(0.0, 0.0, 0.0)).norm() < 1e-12);
         assert!((s.eval(1.0, 1.0).s - net(7)[6][6]).norm() < 1e-12);
+    }
+
+    /// Half a cylinder of radius `r` about the y axis (x ≥ 0 side up to −x), 0 ≤ y ≤ 40, as an
+    /// exact NURBS: u along y (degree 1), v round the circle (two rational quadratic quarters).
+    fn half_cylinder(r: f64) -> BSpline {
+        let circle = [[r, 0.0], [r, r], [0.0, r], [-r, r], [-r, 0.0]];
+        let net: Vec<Vec<P3>> =
+            [0.0, 40.0].iter().map(|&y| circle.iter().map(|c| P3::new(c[0], y, c[1])).collect()).collect();
+        let h = std::f64::consts::FRAC_1_SQRT_2;
+        let w = vec![vec![1.0, h, 1.0, h, 1.0]; 2];
+        BSpline::with_weights(&net, Some(&w), [1, 2], None, Some(vec![0.0, 0.0, 0.0, 0.5, 0.5, 1.0, 1.0, 1.0]))
+    }
+
+    #[test]
+    fn nurbs_cylinder_is_exact() {
+        let s = half_cylinder(20.0);
+        // Every point of the surface is on the circle, and the derivatives are the quotient's
+        // (checked inside the spans, where they are smooth).
+        for k in 0..=50 {
+            let (u, v) = (k as f64 / 50.0, 0.05 + 0.4 * (k as f64 * 0.37).fract() + 0.5 * (k % 2) as f64);
+            let d = s.eval(u, v);
+            assert!((d.s.x.hypot(d.s.z) - 20.0).abs() < 1e-12, "{}", d.s);
+            let h = 1e-6;
+            let dv = (s.eval(u, v + h).s - s.eval(u, v - h).s) / (2.0 * h);
+            let dvv = (s.eval(u, v + h).sv - s.eval(u, v - h).sv) / (2.0 * h);
+            let duv = (s.eval(u, v + h).su - s.eval(u, v - h).su) / (2.0 * h);
+            for (a, b) in [(d.sv, dv), (d.svv, dvv), (d.suv, duv)] {
+                assert!((a - b).norm() < 1e-5 * (1.0 + b.norm()), "{a} vs {b}");
+            }
+        }
+        // Nearest points: radial, at | ρ − R | (closed form), with the outward normal.
+        for (x, y, z) in [(30.0, 5.0, 2.0), (-3.0, 20.0, 7.0), (10.0, 39.0, 30.0), (-25.0, 1.0, 0.5), (1.0, 12.0, 2.0)]
+        {
+            let q = P3::new(x, y, z);
+            let (foot, _, converged) = s.nearest(&q, f64::INFINITY).unwrap();
+            assert!(converged);
+            let rho = x.hypot(z);
+            assert!(((foot.point - q).norm() - (rho - 20.0).abs()).abs() < 1e-9, "{q}: {}", foot.point);
+            assert!((foot.normal - V3::new(x / rho, 0.0, z / rho)).norm() < 1e-9, "{q}: {}", foot.normal);
+        }
     }
 
     #[test]
