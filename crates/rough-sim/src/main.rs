@@ -35,12 +35,16 @@ struct Cli {
 #[derive(Subcommand, Debug)]
 enum Command {
     /// The paper's surface (straight passes along +y, pick feed in x) on a grid: CSV x,y,h.
+    #[command(allow_negative_numbers = true)]
     Patch(PatchArgs),
     /// Figures against feed per tooth, tilt or spindle speed, for one or more radii: CSV table.
+    #[command(allow_negative_numbers = true)]
     Sweep(SweepArgs),
     /// The flat tip of eq. 6–7 (r_M, r_N, r0, δ) and, with --simulate, the simulation's own r0.
+    #[command(allow_negative_numbers = true)]
     FlatTip(FlatArgs),
     /// The surface left by a toolpath table (3- or 5-axis) on a z-map: CSV x,y,z.
+    #[command(allow_negative_numbers = true)]
     Zmap(ZmapArgs),
 }
 
@@ -135,6 +139,9 @@ struct PatchArgs {
     /// Check against dense brute-force sampling of edge points (slow): fail if any lies below the surface by more than 0.1 µm.
     #[arg(long)]
     verify: bool,
+    /// Spacing of the brute-force samples (mm, along the edge and between spindle angles).
+    #[arg(long, default_value_t = 0.004, value_name = "MM")]
+    verify_spacing: f64,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -211,8 +218,8 @@ struct ZmapArgs {
     #[arg(long, default_value_t = 0.01, value_name = "MM")]
     step: f64,
     /// Area x0,y0,x1,y1 (mm); default: all the tool can reach.
-    #[arg(long, value_delimiter = ',', num_args = 4)]
-    area: Vec<f64>,
+    #[arg(long, allow_hyphen_values = true, value_name = "X0,Y0,X1,Y1")]
+    area: Option<String>,
     /// Largest memory for heights (MB).
     #[arg(long, default_value_t = DEFAULT_MEMORY / 1_000_000, value_name = "MB")]
     max_memory: u64,
@@ -285,6 +292,8 @@ fn set_figures(r: &mut Report, c: &CellFigures) {
         .set("classic_peak_um", um(c.classic_peak))
         .set("max_height_um", um(m.max_height))
         .set("max_at_mm", [m.max_at.0, m.max_at.1])
+        .set("peak_um", um(c.peak.0))
+        .set("peak_at_mm", [c.peak.1.0, c.peak.1.1])
         .set("remainder_um", um(c.remainder))
         .set("peak_to_valley_um", um(m.peak_to_valley))
         .set("grid_error_estimate_um", um(m.peak_to_valley - m.peak_to_valley_half))
@@ -336,8 +345,9 @@ fn patch(a: PatchArgs) -> Result<()> {
     if a.verify {
         let area = (-cond.pick / 2.0, cond.pick / 2.0, 0.0, cond.feed_per_tooth);
         let max_radial = (2.0 * cond.cutter.radius * (figs.map.max_height + 0.01)).sqrt().min(cond.cutter.radius);
-        let dtheta = brute::angle_step(max_radial, cond.feed_per_radian(), 0.004);
-        let (worst, samples) = brute::worst_below(&cond, area, dtheta, 0.004, max_radial);
+        let spacing = positive(a.verify_spacing, "--verify-spacing")?;
+        let dtheta = brute::angle_step(max_radial, cond.feed_per_radian(), spacing);
+        let (worst, samples) = brute::worst_below(&cond, area, dtheta, spacing, max_radial);
         report.set("verify_samples", samples).set("verify_worst_below_um", um(worst));
         if worst > 1e-4 {
             return Err(Error::check(format!(
@@ -503,8 +513,12 @@ fn zmap_cmd(a: ZmapArgs) -> Result<()> {
         return Err(Error::input("no rows: a toolpath is needed").at(Location::file(&input.name)));
     }
     let moves = zmap::moves(&t, &input.name, &cutter, spindle, a.feed)?;
-    let (x0, y0, x1, y1) = if a.area.len() == 4 {
-        (a.area[0], a.area[1], a.area[2], a.area[3])
+    let (x0, y0, x1, y1) = if let Some(text) = &a.area {
+        let v: Vec<f64> = text.split(',').filter_map(|t| camkit::num::parse_finite(t.trim()).ok()).collect();
+        if v.len() != 4 {
+            return Err(Error::input(format!("--area must be four numbers x0,y0,x1,y1, got {text:?}")));
+        }
+        (v[0], v[1], v[2], v[3])
     } else {
         zmap::extent(&moves, &cutter)
             .ok_or_else(|| Error::input("no feed move to simulate").at(Location::file(&input.name)))?

@@ -2,7 +2,7 @@
 //! per tooth, tilt and spindle speed (paper 003 fig. 4b, fig. 5b, §3.2).
 
 use crate::figures::{Figures, classic_peak, cusp_classic, cusp_exact, figures};
-use crate::patch::{Conditions, Grid, HeightMap, simulate};
+use crate::patch::{Conditions, Grid, HeightMap, node_source, simulate};
 
 /// Heights above the classic peak by less than this (mm) are not called a remainder: the
 /// solver's and grid's error stays well below it.
@@ -19,6 +19,8 @@ pub struct CellFigures {
     pub classic_peak: f64,
     /// The simulated map's figures.
     pub map: Figures,
+    /// The highest point, refined around the grid's highest node by zooming (mm) and where.
+    pub peak: (f64, (f64, f64)),
     /// Height of the uncut remainder: the surface's highest point if it rises above the classic
     /// peak, else 0 (mm).
     pub remainder: f64,
@@ -42,18 +44,42 @@ pub fn cell_figures(cond: &Conditions, map: &HeightMap) -> CellFigures {
     let r = cond.cutter.radius;
     let f = figures(map, cond.pick, cond.cutter.rotation.sign() > 0.0);
     let classic = classic_peak(r, cond.pick, cond.feed_per_tooth);
-    let remainder = if f.max_height > classic + REMAINDER_MARGIN { f.max_height } else { 0.0 };
+    let peak = refine_peak(cond, f.max_height, f.max_at, map.grid.step);
+    let remainder = if peak.0 > classic + REMAINDER_MARGIN { peak.0 } else { 0.0 };
     CellFigures {
         cusp_classic: cusp_classic(r, cond.pick),
         cusp_exact: cusp_exact(r, cond.pick),
         classic_peak: classic,
         map: f,
+        peak,
         remainder,
     }
 }
 
+/// Zooms in on the neighbourhood of the grid's highest node: four rounds of 11 × 11 exact
+/// evaluations, each over a span a fifth of the last, so the peak between nodes is found.
+pub fn refine_peak(cond: &Conditions, h: f64, at: (f64, f64), step: f64) -> (f64, (f64, f64)) {
+    let mut best = (h, at);
+    let mut half = step;
+    for _ in 0..4 {
+        let centre = best.1;
+        for i in -5..=5 {
+            for j in -5..=5 {
+                let (x, y) = (centre.0 + half * i as f64 / 5.0, centre.1 + half * j as f64 / 5.0);
+                if let Some((v, _)) = node_source(cond, x, y) {
+                    if v > best.0 {
+                        best = (v, (x, y));
+                    }
+                }
+            }
+        }
+        half /= 5.0;
+    }
+    best
+}
+
 /// The header of a figures table row.
-pub const HEADER: &str = "radius,flutes,pick,feed_per_tooth,tilt_deg,pass_phase_deg,spindle_rpm,cusp_classic_um,cusp_exact_um,classic_peak_um,max_height_um,remainder_um,cross_rz_um,cross_ra_um,feed_rz_um,feed_ra_um,down_cut_max_um,up_cut_max_um,grid_error_um";
+pub const HEADER: &str = "radius,flutes,pick,feed_per_tooth,tilt_deg,pass_phase_deg,spindle_rpm,cusp_classic_um,cusp_exact_um,classic_peak_um,max_height_um,peak_um,remainder_um,cross_rz_um,cross_ra_um,feed_rz_um,feed_ra_um,down_cut_max_um,up_cut_max_um,grid_error_um";
 
 /// One row of the figures table (µm) for `cond` (and a spindle speed if the sweep has one).
 pub fn row(cond: &Conditions, spindle: Option<f64>, c: &CellFigures) -> String {
@@ -71,6 +97,7 @@ pub fn row(cond: &Conditions, spindle: Option<f64>, c: &CellFigures) -> String {
         um(c.cusp_exact),
         um(c.classic_peak),
         um(m.max_height),
+        um(c.peak.0),
         um(c.remainder),
         um(m.cross_rz),
         um(m.cross_ra),

@@ -1,0 +1,325 @@
+//! End-to-end tests of `rough-sim`: the paper's figures, the limits the model must reach, the
+//! two simulation paths (paper patch and toolpath z-map) agreeing, the brute-force check, thread
+//! independence and bad input.
+
+use e2e::{Work, bin, data};
+use std::collections::HashMap;
+
+const BIN: &str = "rough-sim";
+
+fn tool() -> String {
+    data("rough-sim/ball-r5-z2.json").to_str().unwrap().to_string()
+}
+
+fn report(w: &Work, name: &str) -> serde_json::Value {
+    serde_json::from_str(&w.read(name)).expect("report is JSON")
+}
+
+fn num(r: &serde_json::Value, key: &str) -> f64 {
+    r[key].as_f64().unwrap_or_else(|| panic!("{key} missing in {r}"))
+}
+
+/// Runs `patch` with extra arguments; returns the report.
+fn patch(w: &Work, extra: &[&str]) -> serde_json::Value {
+    let t = tool();
+    let mut args =
+        vec!["patch", t.as_str(), "--pick", "0.5", "--feed-per-tooth", "0.5", "--report", "r.json", "-o", "h.csv"];
+    args.extend_from_slice(extra);
+    w.run(BIN, &args, b"").ok();
+    report(w, "r.json")
+}
+
+/// Heights of a map CSV keyed by node (µm grid), in mm.
+fn heights(text: &str) -> HashMap<(i64, i64), f64> {
+    text.lines()
+        .skip(1)
+        .filter_map(|l| {
+            let f: Vec<&str> = l.split(',').collect();
+            let key =
+                ((f[0].parse::<f64>().ok()? * 1e6).round() as i64, (f[1].parse::<f64>().ok()? * 1e6).round() as i64);
+            Some((key, f[2].parse::<f64>().ok()?))
+        })
+        .collect()
+}
+
+#[test]
+fn paper_fig2_figures_are_reproduced() {
+    // Fig. 2 conditions as reconstructed in docs/rough-sim.md: r 5, f 0.5, Z 2, 0.5 mm/tooth,
+    // shank leaning to −x, spindle phase advancing 90° per pass.
+    let w = Work::new();
+    let cond = ["--step", "0.002", "--lean", "minus-x", "--pass-phase", "90"];
+    let r0 = patch(&w, &[&cond[..], &["--tilt", "0"]].concat());
+    assert!((num(&r0, "cusp_exact_um") - 6.3).abs() < 1.0, "cusp {r0}");
+    assert!((num(&r0, "remainder_um") - 25.0).abs() < 1.0, "0° remainder {r0}");
+    assert!(num(&r0, "down_cut_max_um") > 2.0 * num(&r0, "up_cut_max_um"), "the remainder is on the down-cut side");
+    let r3 = patch(&w, &[&cond[..], &["--tilt", "3"]].concat());
+    assert!((num(&r3, "remainder_um") - 20.0).abs() < 1.0, "3° remainder {r3}");
+    let r10 = patch(&w, &[&cond[..], &["--tilt", "10"]].concat());
+    assert_eq!(num(&r10, "remainder_um"), 0.0, "10°: no remainder {r10}");
+    assert!(num(&r10, "peak_um") <= num(&r10, "classic_peak_um"));
+}
+
+#[test]
+fn zero_feed_per_tooth_leaves_the_classic_cusp() {
+    let w = Work::new();
+    let t = tool();
+    w.run(
+        BIN,
+        &[
+            "patch",
+            &t,
+            "--pick",
+            "0.5",
+            "--feed-per-tooth",
+            "0.00001",
+            "--step",
+            "0.005",
+            "--report",
+            "r.json",
+            "-o",
+            "h.csv",
+        ],
+        b"",
+    )
+    .ok();
+    let r = report(&w, "r.json");
+    let classic = 0.5f64 * 0.5 / (8.0 * 5.0) * 1e3;
+    assert!((num(&r, "cross_feed_rz_um") - classic).abs() < 0.01, "{r}");
+    assert_eq!(num(&r, "remainder_um"), 0.0);
+}
+
+#[test]
+fn mirrored_rotation_gives_the_mirrored_surface() {
+    let w = Work::new();
+    let t = tool();
+    let base = ["patch", t.as_str(), "--pick", "0.5", "--feed-per-tooth", "0.4", "--step", "0.01", "--tilt", "3"];
+    let a = w.run(BIN, &[&base[..], &["--rotation", "ccw", "--lean", "plus-x"]].concat(), b"").ok();
+    let b = w.run(BIN, &[&base[..], &["--rotation", "cw", "--lean", "minus-x"]].concat(), b"").ok();
+    let (ha, hb) = (heights(&a), heights(&b));
+    assert_eq!(ha.len(), hb.len());
+    let mut worst: f64 = 0.0;
+    for ((x, y), v) in &ha {
+        worst = worst.max((v - hb[&(-x, *y)]).abs());
+    }
+    assert!(worst < 1e-9, "mirror differs by {worst} mm");
+}
+
+#[test]
+fn grid_refinement_converges() {
+    let w = Work::new();
+    let mut peaks = Vec::new();
+    let mut maxes = Vec::new();
+    for step in ["0.008", "0.004", "0.002", "0.001"] {
+        let r = patch(&w, &["--step", step, "--tilt", "3", "--lean", "minus-x"]);
+        peaks.push(num(&r, "peak_um"));
+        maxes.push(num(&r, "max_height_um"));
+    }
+    // The grid maximum rises toward the refined peak; the gap shrinks with the step.
+    let gaps: Vec<f64> = maxes.iter().zip(&peaks).map(|(m, p)| p - m).collect();
+    assert!(gaps.iter().all(|g| *g >= -1e-9), "{gaps:?}");
+    assert!(gaps[3] < 0.1 && gaps[3] <= gaps[0], "{gaps:?}");
+    let spread =
+        peaks.iter().fold(f64::NEG_INFINITY, |a, &b| a.max(b)) - peaks.iter().fold(f64::INFINITY, |a, &b| a.min(b));
+    assert!(spread < 0.1, "refined peaks {peaks:?}");
+}
+
+#[test]
+fn brute_force_edge_points_never_lie_below() {
+    let w = Work::new();
+    for tilt in ["0", "3"] {
+        let r = patch(&w, &["--step", "0.01", "--tilt", tilt, "--verify", "--verify-spacing", "0.02"]);
+        assert!(num(&r, "verify_samples") > 2000.0, "{r}");
+        assert!(num(&r, "verify_worst_below_um") <= 1e-4, "{r}");
+    }
+}
+
+#[test]
+fn output_does_not_depend_on_the_thread_count() {
+    let w = Work::new();
+    let t = tool();
+    let run = |threads: &str| {
+        let out = std::process::Command::new(bin(BIN))
+            .args(["patch", &t, "--pick", "0.5", "--feed-per-tooth", "0.5", "--step", "0.005", "--tilt", "3"])
+            .env("RAYON_NUM_THREADS", threads)
+            .output()
+            .unwrap();
+        assert!(out.status.success());
+        out.stdout
+    };
+    assert_eq!(run("1"), run("2"));
+    let _ = w;
+}
+
+/// A raster table: passes along +y at x = k·0.5, starting a whole number of turns before y = 0.
+fn raster(tilt_deg: f64, lean: f64) -> String {
+    let z = tilt_deg.to_radians();
+    let (i, k) = (lean * z.sin(), z.cos());
+    let mut s = String::from("path,move,x,y,z,i,j,k,f\n");
+    for (p, xc) in [-1.0, -0.5, 0.0, 0.5, 1.0].iter().enumerate() {
+        // Ball centre at (xc, y, 5); tip = centre − 5·axis. 1000 mm/min at 1000 rpm: 1 mm/rev.
+        let tip = |y: f64| (xc - 5.0 * i, y, 5.0 - 5.0 * k);
+        for y in [-8.0, -2.0, 3.0, 8.0] {
+            let (x, yy, zz) = tip(y);
+            s.push_str(&format!("{p},line,{x},{yy},{zz},{i},0,{k},1000\n"));
+        }
+    }
+    s
+}
+
+#[test]
+fn zmap_of_a_raster_table_matches_the_patch() {
+    let w = Work::new();
+    let t = tool();
+    for (tilt, lean) in [(0.0, 1.0), (3.0, -1.0)] {
+        w.write("raster.csv", raster(tilt, lean));
+        let zmap = w
+            .run(
+                BIN,
+                &[
+                    "zmap",
+                    "raster.csv",
+                    "--tool",
+                    &t,
+                    "--spindle",
+                    "1000",
+                    "--step",
+                    "0.02",
+                    "--area",
+                    "-0.25,0,0.25,0.5",
+                    "--report",
+                    "z.json",
+                ],
+                b"",
+            )
+            .ok();
+        let lean_arg = if lean > 0.0 { "plus-x" } else { "minus-x" };
+        let tilt_arg = tilt.to_string();
+        let patch = w
+            .run(
+                BIN,
+                &[
+                    "patch",
+                    &t,
+                    "--pick",
+                    "0.5",
+                    "--feed-per-tooth",
+                    "0.5",
+                    "--step",
+                    "0.02",
+                    "--tilt",
+                    &tilt_arg,
+                    "--lean",
+                    lean_arg,
+                ],
+                b"",
+            )
+            .ok();
+        let (hz, hp) = (heights(&zmap), heights(&patch));
+        let mut worst: f64 = 0.0;
+        let mut compared = 0;
+        for (key, v) in &hp {
+            if let Some(z) = hz.get(key) {
+                worst = worst.max((z - v).abs());
+                compared += 1;
+            }
+        }
+        assert!(compared > 500, "{compared} nodes compared");
+        assert!(worst < 1e-6, "z-map and patch differ by {worst} mm at tilt {tilt}");
+        assert_eq!(report(&w, "z.json")["moves"].as_u64(), Some(15));
+    }
+}
+
+#[test]
+fn flat_tip_eq7_and_the_simulated_flat() {
+    let w = Work::new();
+    let t = tool();
+    w.run(
+        BIN,
+        &[
+            "flat-tip",
+            &t,
+            "--pick",
+            "0.5",
+            "--feed",
+            "1000",
+            "--spindle",
+            "1000",
+            "--simulate",
+            "--step",
+            "0.01",
+            "--report",
+            "f.json",
+        ],
+        b"",
+    )
+    .ok();
+    let r = report(&w, "f.json");
+    assert!((num(&r, "r_m_mm") - 0.5).abs() < 1e-9);
+    assert!((num(&r, "r0_mm") - 0.5).abs() < 1e-9);
+    assert!((num(&r, "delta_um") - 25.06).abs() < 0.01);
+    // The flat of eq. 7 removes the remainder: the surface is the flat itself.
+    assert!(num(&r, "max_height_with_r0_um") < 0.1, "{r}");
+    assert!(num(&r, "max_height_plain_um") > 20.0);
+    let sim = num(&r, "r0_simulated_mm");
+    assert!(sim <= 0.5 + 1e-3 && sim > 0.45, "{r}");
+}
+
+#[test]
+fn bad_input_is_refused_with_one_line() {
+    let w = Work::new();
+    let t = tool();
+    let run = |extra: &[&str]| {
+        let mut args = vec!["patch", t.as_str(), "--pick", "0.5"];
+        args.extend_from_slice(extra);
+        w.run(BIN, &args, b"")
+    };
+    run(&["--feed-per-tooth", "0.5", "--tilt", "90"]).fails(2, "--tilt must be in [0°, 90°)");
+    run(&["--feed-per-tooth", "0.5", "--tilt", "-1"]).fails(2, "--tilt must be in [0°, 90°)");
+    run(&["--feed-per-tooth", "0.5", "--flutes", "0"]).fails(2, "--flutes must be at least 1");
+    run(&["--feed", "0", "--spindle", "1000"]).fails(2, "--feed must be positive");
+    run(&["--feed", "1000", "--spindle", "-5"]).fails(2, "--spindle must be positive");
+    run(&["--feed-per-tooth", "0.5", "--step", "0.00001", "--max-memory", "100"])
+        .fails(2, "more than the bound of 100 MB");
+    w.run(BIN, &["patch", &t, "--pick", "10", "--feed-per-tooth", "0.5"], b"").fails(2, "below the tool diameter");
+    w.write("zero.json", r#"{"kind": "ball", "radius": 5, "flutes": 0}"#);
+    w.run(BIN, &["patch", "zero.json", "--pick", "0.5", "--feed-per-tooth", "0.5"], b"").fails(2, "zero.json (flutes)");
+    w.write("bad.csv", "x,y,z,f\n0,0,0,100\n1,x,0,100\n");
+    w.run(BIN, &["zmap", "bad.csv", "--tool", &t, "--spindle", "1000"], b"").fails(2, "bad.csv:3:2 (y)");
+    w.write("nofeed.csv", "x,y,z\n0,0,0\n1,0,0\n");
+    w.run(BIN, &["zmap", "nofeed.csv", "--tool", &t, "--spindle", "1000"], b"").fails(2, "no feed");
+    assert!(!w.exists("h.csv"));
+}
+
+#[test]
+fn sweep_table_and_plot() {
+    let w = Work::new();
+    let t = tool();
+    let out = w
+        .run(
+            BIN,
+            &[
+                "sweep",
+                &t,
+                "--pick",
+                "0.5",
+                "--feed-per-tooth",
+                "0.5",
+                "--vary",
+                "feed-per-tooth",
+                "--values",
+                "0.1,0.5",
+                "--radii",
+                "5,10",
+                "--step",
+                "0.01",
+                "--svg",
+                "s.svg",
+            ],
+            b"",
+        )
+        .ok();
+    let lines: Vec<&str> = out.lines().collect();
+    assert_eq!(lines.len(), 5);
+    assert!(lines[0].starts_with("radius,flutes,pick,feed_per_tooth"));
+    assert!(w.read("s.svg").contains("r = 10 mm"));
+}
