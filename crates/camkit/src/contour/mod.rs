@@ -14,7 +14,7 @@ pub mod region;
 mod verify;
 
 pub use offset::{Offset, OffsetError, OffsetOptions, offset_contour, offset_region};
-pub use verify::Check;
+pub use verify::{Check, Defect};
 
 use crate::geom::dist::{
     arc_arc_max, arc_arc_min, arc_segment_max, point_arc, point_segment, segment_arc_max, segment_arc_min,
@@ -313,30 +313,21 @@ impl Contour {
         (self.seg_count() > 0).then(|| self.seg(0).point_at(0.5)).or_else(|| self.vertices.first().map(|v| v.p))
     }
 
-    /// First point where the contour crosses or overlaps itself, if any.
+    /// First point where the contour crosses or touches itself, if any (pieces that do not
+    /// follow each other meet), by exact distances.
     pub fn self_crossing(&self) -> Option<P2> {
-        use cavalier_contours::polyline::PlineIntersect;
-        let pline = self.to_pline();
-        let mut found = None;
-        let _: () = pline.visit_self_intersects(&mut |i: PlineIntersect<f64>| {
-            if found.is_none() {
-                let p = match i {
-                    PlineIntersect::Basic(b) => b.point,
-                    PlineIntersect::Overlapping(o) => o.point1,
-                };
-                found = Some(P2::new(p.x, p.y));
-            }
-        });
-        found
+        verify::SegSet::new([self]).first_crossing()
     }
 
     /// First point where this contour and `other` cross or touch, if any.
     pub fn crossing_with(&self, other: &Contour) -> Option<P2> {
-        let r = self.to_pline().find_intersects(&other.to_pline());
-        r.basic_intersects
-            .first()
-            .map(|b| P2::new(b.point.x, b.point.y))
-            .or_else(|| r.overlapping_intersects.first().map(|o| P2::new(o.point1.x, o.point1.y)))
+        let theirs = verify::SegSet::new([other]);
+        self.segs().find_map(|s| {
+            let (lo, hi) = s.bounds();
+            theirs.near(&lo, &hi, 0.0).into_iter().find_map(|j| {
+                (s.min_distance(&theirs.segs[j]) == 0.0).then(|| verify::meeting_point(&s, &theirs.segs[j]))
+            })
+        })
     }
 
     /// The contour as a cavalier_contours polyline.

@@ -147,14 +147,20 @@ fn verified_from(
 ) -> Result<Offset, OffsetError> {
     let set = SegSet::new(input.iter().copied());
     let original: Vec<Contour> = source.iter().map(|c| (*c).clone()).collect();
-    let tidy: Vec<Contour> = source.iter().map(|c| cleaned(c, tol::CLEAN_EPS)).collect();
     let mut attempts = 0;
     let mut defect = None;
     let scale = ladder(source);
-    for (loops, was_cleaned) in [(&original, false), (&tidy, true)] {
-        if was_cleaned && tidy == original {
-            continue;
-        }
+    for was_cleaned in [false, true] {
+        let tidy: Vec<Contour>;
+        let loops = if was_cleaned {
+            tidy = source.iter().map(|c| cleaned(c, tol::CLEAN_EPS)).collect();
+            if tidy == original {
+                continue;
+            }
+            &tidy
+        } else {
+            &original
+        };
         for &eps in &scale {
             attempts += 1;
             let out = kernel(loops, eps);
@@ -201,6 +207,20 @@ pub fn offset_region_further(
     opts: &OffsetOptions,
 ) -> Result<Offset, OffsetError> {
     verified_from(loops, &input.loops(), total, 1.0, true, opts, |source, eps| shape_offset(source, rel, eps))
+}
+
+/// Verifies offsets made elsewhere (another kernel, another run) by the check every result of
+/// this module passes: `output` is the offset of `input` by `d` (mm, > 0) to `side` within `tol`,
+/// closed loops where `closed`.
+pub fn check_offset(
+    input: &[&Contour],
+    output: &[Contour],
+    d: f64,
+    side: Side,
+    closed: bool,
+    tol: f64,
+) -> Result<Check, Defect> {
+    verify(&SegSet::new(input.iter().copied()), output, d, side.sign(), closed, tol)
 }
 
 /// True if `loops` (oriented as a region) still have something left after an inward offset by

@@ -77,10 +77,18 @@ impl Defect {
 /// Pieces of several contours with a spatial index and their neighbours along each contour.
 pub(crate) struct SegSet {
     pub segs: Vec<Seg>,
+    /// A circle around each piece (centre, radius): a cheap lower bound of distances.
+    circles: Vec<(P2, f64)>,
     prev: Vec<Option<usize>>,
     next: Vec<Option<usize>>,
+    /// Runs of consecutive pieces: (circle around them, first piece, one past the last).
+    chunks: Vec<(P2, f64, usize, usize)>,
+    /// Spatial index of the runs' bounds.
     index: Option<StaticAABB2DIndex<f64>>,
 }
+
+/// Pieces per run of the index: runs far from a query are passed over by one circle test.
+const CHUNK: usize = 16;
 
 impl SegSet {
     /// The pieces of `contours`.
@@ -107,28 +115,94 @@ impl SegSet {
                 });
             }
         }
-        let index = (!segs.is_empty()).then(|| {
-            let mut b = StaticAABB2DIndexBuilder::new(segs.len());
-            for s in &segs {
-                let (lo, hi) = s.bounds();
+        let circles: Vec<(P2, f64)> = segs.iter().map(circle_of).collect();
+        // Runs never cross from one contour to the next.
+        let mut chunks = Vec::new();
+        let mut bounds = Vec::new();
+        let mut start = 0;
+        while start < segs.len() {
+            let mut end = start + 1;
+            while end < segs.len() && end - start < CHUNK && prev[end] == Some(end - 1) {
+                end += 1;
+            }
+            let (mut lo, mut hi) = segs[start].bounds();
+            for s in &segs[start + 1..end] {
+                let (a, b) = s.bounds();
+                lo = P2::new(lo.x.min(a.x), lo.y.min(a.y));
+                hi = P2::new(hi.x.max(b.x), hi.y.max(b.y));
+            }
+            let c = P2::from((lo.coords + hi.coords) * 0.5);
+            chunks.push((c, 0.5 * (hi - lo).norm(), start, end));
+            bounds.push((lo, hi));
+            start = end;
+        }
+        let index = (!chunks.is_empty()).then(|| {
+            let mut b = StaticAABB2DIndexBuilder::new(bounds.len());
+            for (lo, hi) in &bounds {
                 b.add(lo.x, lo.y, hi.x, hi.y);
             }
             b.build().expect("as many boxes as declared")
         });
-        SegSet { segs, prev, next, index }
+        SegSet { segs, circles, prev, next, chunks, index }
     }
 
-    /// Indices of pieces whose bounds meet the box `lo..hi` grown by `grow`.
+    /// True if pieces `i` and `j` follow each other along their contour.
+    pub fn adjacent(&self, i: usize, j: usize) -> bool {
+        self.next[i] == Some(j) || self.prev[i] == Some(j)
+    }
+
+    /// First point where two pieces that do not follow each other meet: a crossing or a touch.
+    pub fn first_crossing(&self) -> Option<P2> {
+        (0..self.segs.len())
+            .into_par_iter()
+            .filter_map(|i| {
+                let s = &self.segs[i];
+                let (lo, hi) = s.bounds();
+                let (cs, rs) = self.circles[i];
+                self.near(&lo, &hi, 0.0).into_iter().find_map(|j| {
+                    if j <= i || self.adjacent(i, j) {
+                        return None;
+                    }
+                    let (ct, rt) = self.circles[j];
+                    if (cs - ct).norm() > rs + rt {
+                        return None;
+                    }
+                    let t = &self.segs[j];
+                    (s.min_distance(t) == 0.0).then(|| meeting_point(s, t))
+                })
+            })
+            .find_first(|_| true)
+    }
+
+    /// Indices of pieces that may come within `grow` of the box `lo..hi` (by their circles).
     pub fn near(&self, lo: &P2, hi: &P2, grow: f64) -> Vec<usize> {
-        match &self.index {
-            Some(ix) => ix.query(lo.x - grow, lo.y - grow, hi.x + grow, hi.y + grow),
-            None => Vec::new(),
+        let mut out = Vec::new();
+        let Some(ix) = &self.index else { return out };
+        let c = P2::from((lo.coords + hi.coords) * 0.5);
+        let r = 0.5 * (hi - lo).norm() + grow;
+        for k in ix.query(lo.x - grow, lo.y - grow, hi.x + grow, hi.y + grow) {
+            let (cc, rc, a, b) = self.chunks[k];
+            if (cc - c).norm() > r + rc {
+                continue;
+            }
+            out.extend((a..b).filter(|&i| {
+                let (ci, ri) = self.circles[i];
+                (ci - c).norm() <= r + ri
+            }));
         }
+        out
     }
 
     /// Distance from `p` to the nearest piece, looking no farther than `reach` (∞ beyond it).
     pub fn distance(&self, p: &P2, reach: f64) -> f64 {
-        self.near(p, p, reach).into_iter().map(|i| self.segs[i].distance_to(p)).fold(f64::INFINITY, f64::min)
+        let mut best = f64::INFINITY;
+        for i in self.near(p, p, reach) {
+            let (c, r) = self.circles[i];
+            if (p - c).norm() - r < best {
+                best = best.min(self.segs[i].distance_to(p));
+            }
+        }
+        best
     }
 
     /// Side of `q` relative to piece `i` (positive left), deciding at a corner by both pieces
@@ -149,33 +223,86 @@ impl SegSet {
     }
 }
 
+/// Where two pieces that meet do so: the exact crossing of two lines, else the point of `s`
+/// nearest to `t` found by sampling and golden-section refinement (for messages).
+pub(crate) fn meeting_point(s: &Seg, t: &Seg) -> P2 {
+    if let (Seg::Line(a, b), Seg::Line(c, d)) = (s, t) {
+        let (u, v) = (b - a, d - c);
+        let den = cross2(&u, &v);
+        if den != 0.0 {
+            let k = (cross2(&(c - a), &v) / den).clamp(0.0, 1.0);
+            return a + u * k;
+        }
+    }
+    const SAMPLES: usize = 64;
+    let f = |k: f64| t.distance_to(&s.point_at(k));
+    let best = (0..=SAMPLES).map(|i| i as f64 / SAMPLES as f64).min_by(|a, b| f(*a).total_cmp(&f(*b))).unwrap_or(0.5);
+    let (mut lo, mut hi) = ((best - 1.0 / SAMPLES as f64).max(0.0), (best + 1.0 / SAMPLES as f64).min(1.0));
+    let g = 0.5 * (5f64.sqrt() - 1.0);
+    for _ in 0..60 {
+        let (x1, x2) = (hi - g * (hi - lo), lo + g * (hi - lo));
+        if f(x1) <= f(x2) {
+            hi = x2;
+        } else {
+            lo = x1;
+        }
+    }
+    s.point_at(0.5 * (lo + hi))
+}
+
+/// A circle around a piece: the middle and half the length of a line; the box's for an arc.
+fn circle_of(s: &Seg) -> (P2, f64) {
+    match s {
+        Seg::Line(a, b) => (P2::from((a.coords + b.coords) * 0.5), 0.5 * (b - a).norm()),
+        Seg::Arc(_) => {
+            let (lo, hi) = s.bounds();
+            (P2::from((lo.coords + hi.coords) * 0.5), 0.5 * (hi - lo).norm())
+        }
+    }
+}
+
 /// Measures one output piece: (largest distance above `d`, shortfall below `d`) or a defect.
 fn check_piece(input: &SegSet, s: &Seg, d: f64, side: f64, tol: f64, depth: u32) -> Result<(f64, f64), Defect> {
     let (lo, hi) = s.bounds();
-    let near = input.near(&lo, &hi, d + tol);
     let mid = s.point_at(0.5);
+    let (cs, rs) = circle_of(s);
     let mut clearance = f64::INFINITY;
-    for &i in &near {
-        clearance = clearance.min(s.min_distance(&input.segs[i]));
+    // Candidates for the generator: (distance from the middle, index).
+    let mut cands: Vec<(f64, usize)> = Vec::new();
+    for i in input.near(&lo, &hi, d + tol) {
+        let (ct, rt) = input.circles[i];
+        let bound = (cs - ct).norm() - rs - rt;
+        if bound > d + tol {
+            continue;
+        }
+        let t = &input.segs[i];
+        if bound < d - tol {
+            clearance = clearance.min(s.min_distance(t));
+        }
+        cands.push((t.distance_to(&mid), i));
     }
     if clearance < d - tol {
         return Err(Defect::Gouge(mid, clearance));
     }
-    // The generator: the nearest input pieces first, the first one that covers the piece.
-    let mut order: Vec<(f64, usize)> = near.iter().map(|&i| (input.segs[i].distance_to(&mid), i)).collect();
-    order.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let clearance = clearance.min(d);
     let mut best = f64::INFINITY;
-    for &(dm, i) in &order {
+    // The nearest first: nearly always the generator.
+    if let Some(&(_, i)) = cands.iter().min_by(|a, b| a.0.total_cmp(&b.0)) {
+        let far = s.max_distance_to(&input.segs[i]);
+        best = far;
+        if far <= d + tol {
+            return sided(input, i, &mid, side).map(|_| ((far - d).max(0.0), (d - clearance).max(0.0)));
+        }
+    }
+    cands.sort_by(|a, b| a.0.total_cmp(&b.0));
+    for &(dm, i) in cands.iter().skip(1) {
         if dm > d + tol {
             break;
         }
         let far = s.max_distance_to(&input.segs[i]);
         best = best.min(far);
         if far <= d + tol {
-            if input.side(i, &mid) * side <= 0.0 {
-                return Err(Defect::WrongSide(mid));
-            }
-            return Ok(((far - d).max(0.0), (d - clearance).max(0.0)));
+            return sided(input, i, &mid, side).map(|_| ((far - d).max(0.0), (d - clearance).max(0.0)));
         }
     }
     if depth < 4 && s.length() > tol {
@@ -184,6 +311,11 @@ fn check_piece(input: &SegSet, s: &Seg, d: f64, side: f64, tol: f64, depth: u32)
         return Ok((a.0.max(b.0), a.1.max(b.1)));
     }
     Err(Defect::Stray(mid, best))
+}
+
+/// Checks that `q` lies on `side` of its generator, piece `i`.
+fn sided(input: &SegSet, i: usize, q: &P2, side: f64) -> Result<(), Defect> {
+    if input.side(i, q) * side <= 0.0 { Err(Defect::WrongSide(*q)) } else { Ok(()) }
 }
 
 /// Verifies that `output` is the offset of `input` by `d` (mm, > 0) to `side` (+1 left, −1
@@ -229,22 +361,7 @@ pub(crate) fn verify(
         return Err(Defect::Missing(c));
     }
     // No output loop crosses itself or another.
-    let crossing: Option<P2> = (0..output.len())
-        .into_par_iter()
-        .filter_map(|i| {
-            let a = &output[i];
-            if let Some(p) = a.self_crossing() {
-                return Some(p);
-            }
-            let (alo, ahi) = a.bounds()?;
-            output[i + 1..].iter().find_map(|b| {
-                let (blo, bhi) = b.bounds()?;
-                let overlap = alo.x <= bhi.x && blo.x <= ahi.x && alo.y <= bhi.y && blo.y <= ahi.y;
-                if overlap { a.crossing_with(b) } else { None }
-            })
-        })
-        .find_first(|_| true);
-    if let Some(p) = crossing {
+    if let Some(p) = out.first_crossing() {
         return Err(Defect::Crossing(p));
     }
     Ok(check)

@@ -1,0 +1,126 @@
+//! Side by side with bare cavalier_contours on dense stars and a pocket to empty: time (median
+//! of repeated runs), whether bare cavalier's result passes our verification, and our retries.
+//! Also writes the inputs as polygons for the pyclipper script (`scripts/bench-offset.sh`).
+//!
+//! `cargo run --release -p offset --example offset_peers -- [OUTDIR]`
+
+use camkit::contour::offset::{Side, check_offset, offset_contour};
+use camkit::contour::pocket::{Direction, Passes, PocketOptions, pocket};
+use camkit::contour::region::regions;
+use camkit::contour::{Contour, OffsetOptions, Vertex};
+use camkit::geom::P2;
+use cavalier_contours::polyline::{PlineOffsetOptions, PlineSource, PlineSourceMut, Polyline};
+use cavalier_contours::shape_algorithms::{Shape, ShapeOffsetOptions};
+use std::time::Instant;
+
+/// A star of `n` vertices, r = 50 + 15 cos 8θ; arcs of alternating bulge ±0.05 if `arcs`.
+fn star(n: usize, arcs: bool) -> Contour {
+    let vertices = (0..n)
+        .map(|i| {
+            let a = std::f64::consts::TAU * i as f64 / n as f64;
+            let r = 50.0 + 15.0 * (8.0 * a).cos();
+            let bulge = if arcs { if i % 2 == 0 { 0.05 } else { -0.05 } } else { 0.0 };
+            Vertex { p: P2::new(r * a.cos(), r * a.sin()), bulge }
+        })
+        .collect();
+    Contour { vertices, closed: true }
+}
+
+fn pline(c: &Contour) -> Polyline<f64> {
+    let mut p = Polyline::new_closed();
+    for v in &c.vertices {
+        p.add(v.p.x, v.p.y, v.bulge);
+    }
+    p
+}
+
+fn contour_of(p: &Polyline<f64>) -> Contour {
+    Contour {
+        vertices: p.iter_vertexes().map(|v| Vertex { p: P2::new(v.x, v.y), bulge: v.bulge }).collect(),
+        closed: p.is_closed(),
+    }
+}
+
+/// Median seconds of `runs` calls.
+fn time<T>(runs: usize, mut f: impl FnMut() -> T) -> (f64, T) {
+    let mut out = None;
+    let mut t: Vec<f64> = (0..runs)
+        .map(|_| {
+            let s = Instant::now();
+            out = Some(f());
+            s.elapsed().as_secs_f64()
+        })
+        .collect();
+    t.sort_by(f64::total_cmp);
+    (t[runs / 2], out.expect("ran"))
+}
+
+fn main() {
+    let dir = std::env::args().nth(1).unwrap_or_else(|| "target/offset-bench".into());
+    std::fs::create_dir_all(&dir).expect("output dir");
+    println!("| input | offset | bare cavalier ms | bare result | ours ms | kernel runs | ratio |");
+    println!("|---|---|---|---|---|---|---|");
+    for (n, arcs) in [(1000, false), (10_000, false), (1000, true), (10_000, true)] {
+        let c = star(n, arcs);
+        let poly: String = c.vertices.iter().map(|v| format!("{},{}\n", v.p.x, v.p.y)).collect();
+        let name = format!("star-{n}-{}", if arcs { "arcs" } else { "lines" });
+        std::fs::write(format!("{dir}/{name}.csv"), format!("x,y\n{poly}")).expect("write");
+        let p = pline(&c);
+        for d in [2.0, 5.0, -2.0] {
+            let runs = if n > 5000 { 7 } else { 21 };
+            let (bare_s, bare) = time(runs, || p.parallel_offset_opt(d, &PlineOffsetOptions::default()));
+            let open = bare.iter().filter(|q| !q.is_closed()).count();
+            let side = if d > 0.0 { Side::Left } else { Side::Right };
+            // Bare cavalier's own result through our verification.
+            let bare_contours: Vec<Contour> = bare.iter().map(contour_of).collect();
+            let bare_check = check_offset(&[&c], &bare_contours, d.abs(), side, true, OffsetOptions::default().tol);
+            let (ours_s, ours) = time(runs, || offset_contour(&c, d.abs(), side, &OffsetOptions::default()));
+            let (verdict, runs_used) = match &ours {
+                Ok(o) => (format!("{} loops", o.contours.len()), o.attempts.to_string()),
+                Err(e) => (format!("error: {e}"), "-".into()),
+            };
+            let bare_text = match bare_check {
+                Ok(_) => format!("{} loops, verified", bare.len()),
+                Err(e) => format!("FAILS ({} pieces, {open} open): {}", bare.len(), e.describe()),
+            };
+            println!(
+                "| {name} | {d:+} | {:.2} | {bare_text} | {:.2} ({verdict}) | {runs_used} | {:.2} |",
+                bare_s * 1e3,
+                ours_s * 1e3,
+                ours_s / bare_s
+            );
+        }
+    }
+    // Pocket to empty: the 10k line star, tool radius 1.5, step 2.
+    let c = star(10_000, false);
+    let (rs, _) = regions(std::slice::from_ref(&c)).expect("a region");
+    let opts = PocketOptions {
+        radius: 1.5,
+        step: 2.0,
+        passes: Passes::UntilEmpty,
+        direction: Direction::Climb,
+        offset: OffsetOptions::default(),
+    };
+    let shape = Shape::from_plines([pline(&rs[0].outer)]);
+    let (bare_s, levels) = time(5, || {
+        let mut k = 0;
+        loop {
+            let s = shape.parallel_offset(1.5 + 2.0 * k as f64, &ShapeOffsetOptions::default());
+            if s.ccw_plines.is_empty() && s.cw_plines.is_empty() {
+                break k;
+            }
+            k += 1;
+        }
+    });
+    let (ours_s, ours) = time(5, || pocket(&rs, &opts));
+    let ours = ours.expect("pocket");
+    println!(
+        "| star-10000-lines pocket | r 1.5 step 2 | {:.2} | {levels} levels | {:.2} ({} passes, {} levels) | {} | {:.2} |",
+        bare_s * 1e3,
+        ours_s * 1e3,
+        ours.passes.len(),
+        ours.passes.iter().map(|p| p.level + 1).max().unwrap_or(0),
+        ours.attempts,
+        ours_s / bare_s
+    );
+}
