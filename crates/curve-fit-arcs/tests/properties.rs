@@ -103,7 +103,7 @@ fn noisy_curve(coeffs: &[f64], n: usize, step: f64, noise: &[f64], amplitude: f6
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig { cases: 48, ..ProptestConfig::default() })]
+    #![proptest_config(ProptestConfig { cases: 24, ..ProptestConfig::default() })]
 
     /// Noise below the tolerance: every input point and chord within tol of the output and every
     /// output point within tol of the input, by dense sampling and exact segment distances.
