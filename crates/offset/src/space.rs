@@ -91,8 +91,8 @@ impl Frame {
     }
 }
 
-/// Indices of the window around row `i`: up to `w` mm of contour each way (the whole contour if
-/// it is shorter), in order, and whether that is the whole closed contour.
+/// Indices of the window around row `i`: contour each way up to the first row `w` mm or more
+/// away (the whole contour if it is shorter; at least the neighbours), in order, and whether that is the whole closed contour.
 fn window(pts: &[P3], closed: bool, i: usize, w: f64) -> (Vec<usize>, bool) {
     let n = pts.len();
     let step = |k: usize, fwd: bool| -> Option<usize> {
@@ -107,21 +107,27 @@ fn window(pts: &[P3], closed: bool, i: usize, w: f64) -> (Vec<usize>, bool) {
     let mut back = Vec::new();
     let (mut k, mut len) = (i, 0.0);
     while let Some(j) = step(k, false) {
-        len += (pts[k] - pts[j]).norm();
-        if len > w || j == i || back.len() + 1 >= n {
+        if j == i || back.len() + 1 >= n {
             break;
         }
         back.push(j);
+        len += (pts[k] - pts[j]).norm();
+        if len >= w {
+            break;
+        }
         k = j;
     }
     let mut fwd = Vec::new();
     let (mut k, mut len) = (i, 0.0);
     while let Some(j) = step(k, true) {
-        len += (pts[k] - pts[j]).norm();
-        if len > w || j == i || back.len() + fwd.len() + 2 > n || back.contains(&j) {
+        if j == i || back.len() + fwd.len() + 2 > n || back.contains(&j) {
             break;
         }
         fwd.push(j);
+        len += (pts[k] - pts[j]).norm();
+        if len >= w {
+            break;
+        }
         k = j;
     }
     let whole = closed && back.len() + fwd.len() + 1 == n;

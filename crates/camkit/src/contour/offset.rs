@@ -164,7 +164,7 @@ fn verified_from(
         for &eps in &scale {
             attempts += 1;
             let out = kernel(loops, eps);
-            match verify(&set, &out, d, side, closed, opts.tol) {
+            match verify(&set, &out, d, side, closed, opts.tol, opts.self_crossing_input) {
                 Ok(check) => return Ok(Offset { contours: out, check, attempts, cleaned: was_cleaned }),
                 Err(e) => defect = Some(e),
             }
@@ -220,7 +220,7 @@ pub fn check_offset(
     closed: bool,
     tol: f64,
 ) -> Result<Check, Defect> {
-    verify(&SegSet::new(input.iter().copied()), output, d, side.sign(), closed, tol)
+    verify(&SegSet::new(input.iter().copied()), output, d, side.sign(), closed, tol, false)
 }
 
 /// True if `loops` (oriented as a region) still have something left after an inward offset by

@@ -1,0 +1,510 @@
+//! End-to-end tests of `offset`: every mode on the built binary against exact answers (circles,
+//! rectangles, removed loops, pockets with islands, the paper's sine for square and ball end
+//! mills through `curve-fit-arcs`, a square on a tilted plane), and bad input refused with one
+//! clear line and no output file.
+
+use camkit::geom::P2;
+use camkit::geom::dist::point_segment;
+use e2e::Work;
+use std::collections::HashMap;
+use std::f64::consts::{PI, TAU};
+
+const BIN: &str = "offset";
+/// The promise: every output point within this of distance R (mm).
+const TOL: f64 = 1e-6;
+
+/// Rows of a CSV table as maps from column name to text.
+fn table(text: &str) -> Vec<HashMap<String, String>> {
+    let mut lines = text.lines().filter(|l| !l.starts_with('#'));
+    let header: Vec<String> = lines.next().expect("header").split(',').map(str::to_string).collect();
+    lines.map(|l| header.iter().cloned().zip(l.split(',').map(str::to_string)).collect::<HashMap<_, _>>()).collect()
+}
+
+fn num(row: &HashMap<String, String>, col: &str) -> f64 {
+    row[col].parse().unwrap_or_else(|_| panic!("{col} = {:?}", row[col]))
+}
+
+/// One piece of a written path.
+#[derive(Clone, Copy, Debug)]
+enum Piece {
+    Line(P2, P2),
+    /// Centre, radius, start angle, signed sweep.
+    Arc(P2, f64, f64, f64),
+}
+
+impl Piece {
+    fn at(&self, t: f64) -> P2 {
+        match *self {
+            Piece::Line(a, b) => a + (b - a) * t,
+            Piece::Arc(c, r, a0, sw) => c + r * camkit::geom::V2::new((a0 + t * sw).cos(), (a0 + t * sw).sin()),
+        }
+    }
+
+    fn distance(&self, p: &P2) -> f64 {
+        match *self {
+            Piece::Line(a, b) => point_segment(p, &a, &b),
+            Piece::Arc(c, r, a0, sw) => {
+                let phi = (p.y - c.y).atan2(p.x - c.x);
+                let k = ((phi - a0) * sw.signum()).rem_euclid(TAU);
+                if k <= sw.abs() {
+                    ((p - c).norm() - r).abs()
+                } else {
+                    (p - self.at(0.0)).norm().min((p - self.at(1.0)).norm())
+                }
+            }
+        }
+    }
+}
+
+/// Pieces of each path of a table (columns `u`, `v` as the plane's axes).
+fn paths_in(text: &str, u: &str, v: &str) -> Vec<Vec<Piece>> {
+    let rows = table(text);
+    let mut out: Vec<Vec<Piece>> = Vec::new();
+    let mut last: Option<(String, P2)> = None;
+    for r in &rows {
+        let p = P2::new(num(r, u), num(r, v));
+        let id = r.get("path").cloned().unwrap_or_default();
+        match &last {
+            Some((pid, from)) if *pid == id && r["move"] != "rapid" => {
+                let piece = match r["move"].as_str() {
+                    "line" => Piece::Line(*from, p),
+                    m => {
+                        let c = P2::new(num(r, &format!("{u}c")), num(r, &format!("{v}c")));
+                        let a0 = (from.y - c.y).atan2(from.x - c.x);
+                        let a1 = (p.y - c.y).atan2(p.x - c.x);
+                        let mut sw = (a1 - a0).rem_euclid(TAU);
+                        if sw < 1e-12 {
+                            sw = TAU;
+                        }
+                        if m == "cw" {
+                            sw -= TAU;
+                        }
+                        // Written centres are rounded: the arc is the one through both ends
+                        // with this sweep (as the filters read it).
+                        assert!(((p - c).norm() - (*from - c).norm()).abs() < 1e-5, "arc ends at its radius");
+                        let chord = p - *from;
+                        let b = (sw / 4.0).tan();
+                        let left = camkit::geom::V2::new(-chord.y, chord.x);
+                        let c = *from + chord * 0.5 + left * ((1.0 - b * b) / (4.0 * b));
+                        let a0 = (from.y - c.y).atan2(from.x - c.x);
+                        Piece::Arc(c, (*from - c).norm(), a0, sw)
+                    }
+                };
+                out.last_mut().expect("a path").push(piece);
+            }
+            _ => out.push(Vec::new()),
+        }
+        last = Some((id, p));
+    }
+    out
+}
+
+fn paths(text: &str) -> Vec<Vec<Piece>> {
+    paths_in(text, "x", "y")
+}
+
+/// Sample points of every piece (ends and 15 interior points).
+fn samples(path: &[Piece]) -> Vec<P2> {
+    path.iter().flat_map(|s| (0..=16).map(move |k| s.at(k as f64 / 16.0))).collect()
+}
+
+/// Distance from `p` to a closed polygon.
+fn polygon_distance(p: &P2, poly: &[P2]) -> f64 {
+    (0..poly.len()).map(|i| point_segment(p, &poly[i], &poly[(i + 1) % poly.len()])).fold(f64::INFINITY, f64::min)
+}
+
+/// A closed polygon as a table (one path).
+fn polygon_csv(path: i64, poly: &[P2]) -> String {
+    let mut s = String::new();
+    for (k, p) in poly.iter().chain(std::iter::once(&poly[0])).enumerate() {
+        s.push_str(&format!("{path},{},{},{},,\n", if k == 0 { "rapid" } else { "line" }, p.x, p.y));
+    }
+    s
+}
+
+const HEAD: &str = "path,move,x,y,xc,yc\n";
+
+fn report(w: &Work, name: &str) -> serde_json::Value {
+    serde_json::from_str(&w.read(name)).expect("report is JSON")
+}
+
+fn pts(v: &[(f64, f64)]) -> Vec<P2> {
+    v.iter().map(|&(x, y)| P2::new(x, y)).collect()
+}
+
+#[test]
+fn circle_offsets_are_arcs_of_radius_r0_plus_or_minus_r() {
+    let w = Work::new();
+    // A counter-clockwise circle of radius 10 about (3, -1), as G-code too.
+    let csv = format!("{HEAD}0,rapid,13,-1,,\n0,ccw,-7,-1,3,-1\n0,ccw,13,-1,3,-1\n");
+    w.write("circle.csv", &csv);
+    w.write("circle.nc", "G21 G90\nG0 X13 Y-1 Z0\nG3 X-7 Y-1 I-10 J0 F500\nG3 X13 Y-1 I10 J0\nM2\n");
+    for (input, side, r, expect) in [
+        ("circle.csv", "left", 2.5, 7.5),
+        ("circle.csv", "right", 2.5, 12.5),
+        ("circle.nc", "G41", 4.0, 6.0),
+        ("circle.csv", "+1", 0.5, 10.5),
+    ] {
+        let out = w.run(BIN, &[input, "--radius", &r.to_string(), "--side", side], b"").ok();
+        let ps = paths(&out);
+        assert_eq!(ps.len(), 1, "{side}: {out}");
+        for piece in &ps[0] {
+            let Piece::Arc(c, rad, _, sw) = *piece else { panic!("an arc's offset is an arc: {piece:?}") };
+            assert!((c - P2::new(3.0, -1.0)).norm() < TOL && (rad - expect).abs() < TOL, "{c} {rad}");
+            assert!(sw > 0.0, "still counter-clockwise");
+        }
+        let swept: f64 = ps[0].iter().map(|p| if let Piece::Arc(_, _, _, s) = p { *s } else { 0.0 }).sum();
+        assert!((swept - TAU).abs() < 1e-9, "one full turn: {swept}");
+    }
+    // Larger than the circle: nothing to cut, a warning, exit status 0.
+    let out = w.run(BIN, &["circle.csv", "--radius", "10.5", "--side", "left", "-o", "gone.csv"], b"");
+    out.ok();
+    assert!(out.stderr.contains("leaves nothing"), "{}", out.stderr);
+    assert!(paths(&w.read("gone.csv")).is_empty());
+}
+
+#[test]
+fn rectangle_outside_gets_corner_arcs_of_radius_r_inside_stays_sharp() {
+    let w = Work::new();
+    let rect = pts(&[(0.0, 0.0), (40.0, 0.0), (40.0, 20.0), (0.0, 20.0)]);
+    w.write("rect.csv", format!("{HEAD}{}", polygon_csv(7, &rect)));
+    let out = w.run(BIN, &["rect.csv", "--radius", "3", "--side", "right", "--report", "r.json"], b"").ok();
+    let ps = paths(&out);
+    assert_eq!(ps.len(), 1);
+    let arcs: Vec<(P2, f64, f64)> =
+        ps[0].iter().filter_map(|p| if let Piece::Arc(c, r, _, s) = p { Some((*c, *r, *s)) } else { None }).collect();
+    assert_eq!(arcs.len(), 4, "one arc per convex corner");
+    for (c, r, s) in arcs {
+        assert!(rect.iter().any(|q| (q - c).norm() < TOL), "arc centred on a corner: {c}");
+        assert!((r - 3.0).abs() < TOL && (s - PI / 2.0).abs() < 1e-9);
+    }
+    for p in samples(&ps[0]) {
+        assert!((polygon_distance(&p, &rect) - 3.0).abs() <= TOL, "{p}");
+    }
+    let rep = report(&w, "r.json");
+    assert!(rep["largest_deviation_mm"].as_f64().unwrap() <= TOL);
+    assert!(out.lines().skip(1).all(|l| l.starts_with("0,")), "paths renumbered from 0");
+    // Inside: the 34 × 14 rectangle, corners trimmed sharp.
+    let out = w.run(BIN, &["rect.csv", "--radius", "3", "--side", "left"], b"").ok();
+    let ps = paths(&out);
+    assert!(ps[0].iter().all(|p| matches!(p, Piece::Line(..))));
+    for p in samples(&ps[0]) {
+        assert!((polygon_distance(&p, &rect) - 3.0).abs() <= TOL);
+        assert!(p.x >= 3.0 - TOL && p.x <= 37.0 + TOL && p.y >= 3.0 - TOL && p.y <= 17.0 + TOL);
+    }
+}
+
+#[test]
+fn invalid_loops_are_removed_necks_split_and_narrow_slots_stay_uncut() {
+    let w = Work::new();
+    // Two 20 × 20 rooms joined by a neck 2 mm wide, and a slot 2 mm wide into the right room.
+    let shape = pts(&[
+        (0.0, 0.0),
+        (20.0, 0.0),
+        (20.0, 9.0),
+        (30.0, 9.0),
+        (30.0, 0.0),
+        (50.0, 0.0),
+        (50.0, 20.0),
+        (41.0, 20.0),
+        (41.0, 8.0),
+        (39.0, 8.0),
+        (39.0, 20.0),
+        (30.0, 20.0),
+        (30.0, 11.0),
+        (20.0, 11.0),
+        (20.0, 20.0),
+        (0.0, 20.0),
+    ]);
+    w.write("rooms.csv", format!("{HEAD}{}", polygon_csv(0, &shape)));
+    let out = w.run(BIN, &["rooms.csv", "--radius", "1.5", "--side", "left", "--svg", "rooms.svg"], b"").ok();
+    let ps = paths(&out);
+    assert_eq!(ps.len(), 2, "the neck splits the offset into two loops");
+    for path in &ps {
+        for p in samples(path) {
+            let d = polygon_distance(&p, &shape);
+            assert!((d - 1.5).abs() <= TOL, "{p} at {d}");
+            assert!(!(p.x > 20.0 && p.x < 30.0), "nothing in the neck: {p}");
+            assert!(!(p.x > 39.0 && p.x < 41.0 && p.y > 8.0), "nothing in the slot: {p}");
+        }
+    }
+    assert!(w.read("rooms.svg").starts_with("<svg") || w.read("rooms.svg").contains("<svg"));
+    // A wider tool at 1 mm fits the neck: one loop through it.
+    let out = w.run(BIN, &["rooms.csv", "--radius", "0.9", "--side", "left"], b"").ok();
+    assert_eq!(paths(&out).len(), 1);
+}
+
+#[test]
+fn pocket_with_an_island_passes_at_every_step_in_machining_order() {
+    let w = Work::new();
+    let square = pts(&[(0.0, 0.0), (60.0, 0.0), (60.0, 60.0), (0.0, 60.0)]);
+    // The island given counter-clockwise: it is turned around (with a warning).
+    let csv = format!("{HEAD}{}1,rapid,35,30,,\n1,ccw,25,30,30,30\n1,ccw,35,30,30,30\n", polygon_csv(0, &square));
+    w.write("pocket.csv", &csv);
+    let out = w.run(
+        BIN,
+        &["pocket.csv", "--radius", "1.5", "--repeat", "3", "--step", "2", "--report", "p.json", "-o", "p.csv"],
+        b"",
+    );
+    out.ok();
+    assert!(out.stderr.contains("turned around"), "{}", out.stderr);
+    let text = w.read("p.csv");
+    let rows = table(&text);
+    let ps = paths(&text);
+    assert_eq!(ps.len(), 6, "3 levels around the boundary and 3 around the island");
+    let mut seen = Vec::new();
+    for (k, path) in ps.iter().enumerate() {
+        let d: f64 = num(rows.iter().find(|r| r["path"] == k.to_string()).unwrap(), "offset");
+        let island = samples(path).iter().all(|p| (p - P2::new(30.0, 30.0)).norm() < 20.0);
+        for p in samples(path) {
+            let to_boundary = polygon_distance(&p, &square);
+            let to_island = ((p - P2::new(30.0, 30.0)).norm() - 5.0).abs();
+            assert!((to_boundary.min(to_island) - d).abs() <= TOL, "path {k} at {p}: {to_boundary} {to_island} vs {d}");
+            assert!(to_boundary >= d - TOL && to_island >= d - TOL, "no gouge");
+        }
+        if island {
+            assert!(path.iter().all(|p| matches!(p, Piece::Arc(_, r, _, _) if (r - 5.0 - d).abs() < TOL)));
+        }
+        seen.push((island, d));
+    }
+    let mut ds: Vec<f64> = seen.iter().map(|s| s.1).collect();
+    ds.sort_by(f64::total_cmp);
+    ds.dedup_by(|a, b| (*a - *b).abs() < 1e-12);
+    assert_eq!(ds, vec![1.5, 3.5, 5.5]);
+    let rep = report(&w, "p.json");
+    assert_eq!(rep["islands"], 1);
+    assert_eq!(rep["passes"], 6);
+    // Until empty: a 20 × 20 square with R 1.5, step 2 has levels 1.5 .. 9.5 (inscribed radius 10).
+    let small = pts(&[(0.0, 0.0), (20.0, 0.0), (20.0, 20.0), (0.0, 20.0)]);
+    w.write("small.csv", format!("{HEAD}{}", polygon_csv(0, &small)));
+    let out =
+        w.run(BIN, &["small.csv", "--radius", "1.5", "--until-empty", "--step", "2", "--report", "u.json"], b"").ok();
+    let offsets: Vec<f64> = table(&out).iter().map(|r| num(r, "offset")).collect();
+    let deepest = offsets.iter().copied().fold(0.0, f64::max);
+    assert!((9.5 - TOL..10.0).contains(&deepest), "{deepest}");
+    for (k, path) in paths(&out).iter().enumerate() {
+        let d = num(table(&out).iter().find(|r| r["path"] == k.to_string()).unwrap(), "offset");
+        for p in samples(path) {
+            assert!((polygon_distance(&p, &small) - d).abs() <= TOL);
+        }
+    }
+    // A tool wider than the pocket: nothing to cut, a warning, status 0.
+    let out = w.run(BIN, &["small.csv", "--radius", "11", "--repeat", "1"], b"");
+    out.ok();
+    assert!(out.stderr.contains("does not fit"), "{}", out.stderr);
+}
+
+/// The paper's sine: y = 10 sin(2π x / 62.8).
+fn sine(x: f64) -> f64 {
+    10.0 * (TAU * x / 62.8).sin()
+}
+
+/// Highest point of the sine over [a, b] ∩ [0, 62.8], in closed form.
+fn sine_window_max(a: f64, b: f64) -> f64 {
+    let (a, b) = (a.max(0.0), b.min(62.8));
+    let crest = 62.8 / 4.0;
+    if a <= crest && crest <= b { 10.0 } else { sine(a).max(sine(b)) }
+}
+
+/// Height of a u-monotone tip path at `u`.
+fn height_at(path: &[Piece], u: f64) -> f64 {
+    for p in path {
+        let (a, b) = (p.at(0.0), p.at(1.0));
+        if u < a.x.min(b.x) - 1e-12 || u > a.x.max(b.x) + 1e-12 {
+            continue;
+        }
+        return match *p {
+            Piece::Line(a, b) if (b.x - a.x).abs() < 1e-12 => a.y.max(b.y),
+            Piece::Line(a, b) => a.y + (u - a.x) / (b.x - a.x) * (b.y - a.y),
+            Piece::Arc(c, r, _, _) => {
+                // The branch of the circle the piece lies on: its middle decides.
+                let m = p.at(0.5);
+                let h = (r * r - (u - c.x).powi(2)).max(0.0).sqrt();
+                if m.y >= c.y { c.y + h } else { c.y - h }
+            }
+        };
+    }
+    panic!("u = {u} outside the tip path");
+}
+
+#[test]
+fn sine_profile_for_ball_and_square_end_mills_through_curve_fit_arcs() {
+    let w = Work::new();
+    let mut points = String::from("x,y\n");
+    for i in 0..=628 {
+        let x = i as f64 * 0.1;
+        points.push_str(&format!("{x:.4},{:.9}\n", sine(x)));
+    }
+    w.write("points.csv", points);
+    w.run("curve-fit-arcs", &["points.csv", "--tol", "0.01", "-o", "fitted.csv"], b"").ok();
+    let fitted = w.read("fitted.csv");
+    let profile = paths(&fitted).concat();
+    assert!(profile.iter().any(|p| matches!(p, Piece::Arc(..))), "the fit has arcs");
+    let r = 1.5;
+    // Ball: the centre (tip + R up) is at distance R from the fitted profile, within 1e-6 mm.
+    let ball = w
+        .run(BIN, &["fitted.csv", "--radius", "1.5", "--profile", "ball", "--up", "y", "--report", "b.json"], b"")
+        .ok();
+    let tip = paths(&ball).concat();
+    assert!(tip.iter().any(|p| matches!(p, Piece::Arc(..))), "arcs stay arcs");
+    for q in samples(&tip) {
+        let c = q + camkit::geom::V2::new(0.0, r);
+        let d = profile.iter().map(|p| p.distance(&c)).fold(f64::INFINITY, f64::min);
+        assert!((d - r).abs() <= TOL, "ball centre {c} at {d} from the profile");
+    }
+    // Square: the tip height at u is the sine's highest point within R of u (closed form),
+    // within the fit's tolerance.
+    let square = w
+        .run(
+            BIN,
+            &[
+                "fitted.csv",
+                "--radius",
+                "1.5",
+                "--profile",
+                "square",
+                "--up",
+                "y",
+                "--report",
+                "s.json",
+                "--svg",
+                "s.svg",
+            ],
+            b"",
+        )
+        .ok();
+    let tip = paths(&square).concat();
+    let mut worst = 0.0f64;
+    for i in 0..=6280 {
+        let u = i as f64 * 0.01;
+        worst = worst.max((height_at(&tip, u) - sine_window_max(u - r, u + r)).abs());
+    }
+    // The fit holds 0.01 mm normal to the sine (+1.3e-4 between samples); vertically that is
+    // up to √(1 + slope²) = √2 times more where the sine is steepest.
+    assert!(worst <= 0.0102 * 2f64.sqrt(), "square tip path off the closed form by {worst} mm");
+    let own = report(&w, "s.json")["largest_deviation_mm"].as_f64().unwrap();
+    assert!(own <= TOL, "the filter's own check of the tip path against the fitted profile: {own}");
+    // The paper's observation: the unoffset square end mill cuts through the sine everywhere but
+    // near x = 15.7 and 47.1 mm, checked against the closed-form sine.
+    let rep = report(&w, "s.json");
+    let centres: Vec<f64> =
+        rep["unoffset_square_clear_centres_mm"].as_array().unwrap().iter().map(|v| v.as_f64().unwrap()).collect();
+    assert_eq!(centres.len(), 2, "{centres:?}");
+    assert!((centres[0] - 15.7).abs() < 0.1 && (centres[1] - 47.1).abs() < 0.1, "{centres:?}");
+    // Clear (the bottom on one side of the sine) only where 10 (1 − cos(2π δ / 62.8)) ≤ 0.01 mm,
+    // δ ≤ 0.45 mm from a crest or trough; cutting through everywhere else.
+    for i in 0..=628 {
+        let u = i as f64 * 0.1;
+        let inside = u >= r && u <= 62.8 - r;
+        let f = sine(u);
+        let (above, below) = (0..=300)
+            .map(|k| sine(u - r + k as f64 * 0.01) - f)
+            .fold((0.0f64, 0.0f64), |(a, b), d| (a.max(d), b.max(-d)));
+        let through = above > 0.01 && below > 0.01;
+        let delta = (u - 15.7).abs().min((u - 47.1).abs());
+        if inside && delta < 0.4 {
+            assert!(!through, "u = {u}");
+        } else if inside && delta > 0.5 {
+            assert!(through, "u = {u}");
+        }
+        let reported_clear = rep["unoffset_square_clear_mm"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .any(|s| s[0].as_f64().unwrap() <= u && u <= s[1].as_f64().unwrap());
+        if inside && !(0.4..=0.5).contains(&delta) {
+            assert_eq!(reported_clear, !through, "the report at u = {u}");
+        }
+    }
+    assert!(rep["unoffset_square_deepest_gouge_mm"].as_f64().unwrap() > 1.0);
+    let svg = w.read("s.svg");
+    assert!(svg.contains("gouge of the unoffset path"), "the plot shows the gouge regions");
+}
+
+#[test]
+fn three_d_square_on_a_tilted_plane_is_offset_in_that_plane() {
+    let w = Work::new();
+    let t = 30f64.to_radians();
+    let n = (0.0, -t.sin(), t.cos());
+    let corners = [(0.0, 0.0), (20.0, 0.0), (20.0, 10.0), (0.0, 10.0), (0.0, 0.0)];
+    let mut csv = String::from("path,move,x,y,z,i,j,k\n");
+    for (k, (u, v)) in corners.iter().enumerate() {
+        let mv = if k == 0 { "rapid" } else { "line" };
+        csv.push_str(&format!("0,{mv},{u},{},{},{},{},{}\n", v * t.cos(), v * t.sin(), n.0, n.1, n.2));
+    }
+    w.write("tilt.csv", csv);
+    let out = w.run(BIN, &["tilt.csv", "--3d", "--radius", "2", "--side", "right", "--report", "t.json"], b"").ok();
+    let rows = table(&out);
+    assert!(rows.len() > 8, "corners rounded by several points");
+    let rect = pts(&corners[..4]);
+    for r in &rows {
+        let (x, y, z) = (num(r, "x"), num(r, "y"), num(r, "z"));
+        // In the plane, and at distance R (up to the chord tolerance at corners) from the square.
+        assert!((x * n.0 + y * n.1 + z * n.2).abs() < 1e-9, "off the plane: {x} {y} {z}");
+        let (u, v) = (x, y * t.cos() + z * t.sin());
+        let d = polygon_distance(&P2::new(u, v), &rect);
+        assert!((2.0 - TOL..=2.0 + 0.001 + TOL).contains(&d), "({u}, {v}) at {d}");
+        assert!(!(0.0..=20.0).contains(&u) || !(0.0..=10.0).contains(&v), "outside, on the right of travel");
+    }
+    let rep = report(&w, "t.json");
+    assert!(rep["largest_excess_mm"].as_f64().unwrap() <= 0.001 + TOL);
+    assert_eq!(rep["rounded_corners"], 4);
+}
+
+#[test]
+fn zero_length_moves_are_dropped_and_counted() {
+    let w = Work::new();
+    let csv =
+        format!("{HEAD}0,rapid,0,0,,\n0,line,10,0,,\n0,line,10,0,,\n0,line,10,10,,\n0,line,0,10,,\n0,line,0,0,,\n");
+    w.write("dup.csv", csv);
+    w.run(BIN, &["dup.csv", "--radius", "1", "--side", "left", "--report", "d.json"], b"").ok();
+    assert_eq!(report(&w, "d.json")["dropped_zero_length_moves"], 1);
+}
+
+#[test]
+fn bad_input_is_refused_with_one_line_and_no_output_file() {
+    let w = Work::new();
+    let bow = format!("{HEAD}0,rapid,0,0,,\n0,line,20,10,,\n0,line,20,0,,\n0,line,0,10,,\n0,line,0,0,,\n");
+    w.write("bow.csv", &bow);
+    w.write("open.csv", format!("{HEAD}0,rapid,0,0,,\n0,line,10,0,,\n0,line,10,10,,\n"));
+    w.write("nan.csv", format!("{HEAD}0,rapid,0,0,,\n0,line,NaN,0,,\n0,line,10,10,,\n"));
+    w.write("text.csv", format!("{HEAD}0,rapid,0,0,,\n0,line,1O,0,,\n"));
+    w.write("nox.csv", "path,move,y\n0,line,1\n");
+    w.write("empty.csv", "");
+    let cases: &[(&[&str], &str)] = &[
+        (&["bow.csv", "--radius", "1", "--side", "left"], "bow.csv:2"),
+        (&["bow.csv", "--radius", "1", "--side", "left"], "crosses itself at (10.000000, 5.000000)"),
+        (&["open.csv", "--radius", "1", "--repeat", "2"], "open.csv:4"),
+        (&["nan.csv", "--radius", "1", "--side", "left"], "nan.csv:3"),
+        (&["text.csv", "--radius", "1", "--side", "left"], "text.csv:3"),
+        (&["nox.csv", "--radius", "1", "--side", "left"], "x"),
+        (&["empty.csv", "--radius", "1", "--side", "left"], "empty.csv"),
+        (&["open.csv", "--radius", "0", "--side", "left"], "--radius"),
+        (&["open.csv", "--radius", "-2", "--side", "left"], "--radius"),
+        (&["open.csv", "--radius", "NaN", "--side", "left"], "--radius"),
+        (&["open.csv", "--radius", "1"], "--side"),
+        (&["open.csv", "--radius", "1", "--side", "up"], "--side"),
+    ];
+    for (args, needle) in cases {
+        let mut a: Vec<&str> = args.to_vec();
+        a.extend(["-o", "out.csv", "--report", "out.json", "--svg", "out.svg"]);
+        w.run(BIN, &a, b"").fails(2, needle);
+        assert!(!w.exists("out.csv") && !w.exists("out.json") && !w.exists("out.svg"), "{args:?}: {:?}", w.files());
+    }
+    // A column name is named with the position.
+    let out = w.run(BIN, &["text.csv", "--radius", "1", "--side", "left"], b"");
+    assert!(out.stderr.contains('x'), "{}", out.stderr);
+    // A crossing may be accepted on request: an open path looping over itself.
+    w.write(
+        "loop.csv",
+        format!("{HEAD}0,rapid,0,0,,\n0,line,20,0,,\n0,line,20,10,,\n0,line,10,10,,\n0,line,10,-10,,\n"),
+    );
+    w.run(BIN, &["loop.csv", "--radius", "1", "--side", "left"], b"")
+        .fails(2, "crosses itself at (10.000000, 0.000000)");
+    let out = w.run(BIN, &["loop.csv", "--radius", "1", "--side", "left", "--allow-self-crossing"], b"").ok();
+    let shape = [P2::new(0.0, 0.0), P2::new(20.0, 0.0), P2::new(20.0, 10.0), P2::new(10.0, 10.0), P2::new(10.0, -10.0)];
+    for p in paths(&out).iter().flat_map(|p| samples(p)) {
+        let d = (0..4).map(|i| point_segment(&p, &shape[i], &shape[i + 1])).fold(f64::INFINITY, f64::min);
+        assert!((d - 1.0).abs() <= TOL, "{p} at {d}");
+    }
+}
