@@ -23,7 +23,9 @@ pub fn trace_level(
     let curve = PlaneCurve { model, stylus, plane_normal: V3::z() };
     let r = stylus.radius;
     let mut loops: Vec<(Vec<CurvePoint>, f64)> = Vec::new();
-    for seed in seeds(&curve, region, z) {
+    // Loops wholly behind the surface (inside a solid) are never written: only seeds in front
+    // start a loop, and the parts of a loop behind a sheet's edge are cut out below.
+    for seed in seeds(&curve, region, z).into_iter().filter(|s| s.cl.front) {
         let covered =
             loops.iter().any(|(pts, dev)| near_polyline(&seed.cl.centre, pts, dev + steps.chord_tol * 2.0 + 1e-6));
         if covered {
