@@ -1,15 +1,20 @@
-# sine (paper 004): one period of the paper's sine profile → lines and arcs → NC and a plot.
+# sine (paper 004): one period of the paper's sine profile → lines and arcs → NC and a plot, then
+# (paper 004 §4, fig. 6) the tip paths of a square and a ball end mill of radius 1.5 mm cutting
+# it from above → NC and plots, with the gouge regions of the unoffset square end mill.
 # The paper's frame is 628 × 200 px for 62.8 mm × 20 mm, so the sine's amplitude is 10 mm.
 DEMOS += sine
-FILTERS += curve-fit-arcs
+FILTERS += curve-fit-arcs offset
 SINE := $(OUT)/sine
 SINE_LENGTH ?= 62.8
 SINE_AMPLITUDE ?= 10
 SINE_STEP ?= 0.1
 SINE_TOL ?= 0.01
+SINE_TOOL_RADIUS ?= 1.5
+SINE_TOOLS := square ball
 
 .PHONY: demo-sine
-demo-sine: $(SINE)/fitted.csv $(SINE)/paper.csv $(SINE)/fitted.nc
+demo-sine: $(SINE)/fitted.csv $(SINE)/paper.csv $(SINE)/fitted.nc \
+  $(foreach t,$(SINE_TOOLS),$(SINE)/tip-$(t).csv $(SINE)/tip-$(t).nc)
 
 $(SINE)/points.csv: mk/sine.mk | $(SINE)/
 	awk -v len=$(SINE_LENGTH) -v a=$(SINE_AMPLITUDE) -v step=$(SINE_STEP) 'BEGIN { \
@@ -25,3 +30,19 @@ $(SINE)/paper.csv $(SINE)/paper.svg $(SINE)/paper.json &: $(SINE)/points.csv $(R
 
 $(SINE)/fitted.nc: $(SINE)/points.csv $(RELEASE)/curve-fit-arcs
 	$(RELEASE)/curve-fit-arcs $< --to gcode --tol $(SINE_TOL) -o $@
+
+# The fitted profile stood up in the xz plane (the tool along +z, as a 3-axis mill cuts it): y → z.
+# Arcs seen from +y turn the other way round (G18), so cw and ccw swap.
+$(SINE)/profile-xz.csv: $(SINE)/fitted.csv
+	awk -F, 'NR == 1 { print "path,move,x,y,z,xc,zc,plane"; next } \
+	  { m = $$1; arc = (m == "cw" || m == "ccw"); if (m == "cw") m = "ccw"; else if (m == "ccw") m = "cw"; \
+	    print "0," m "," $$2 ",0," $$3 "," $$4 "," $$5 "," (arc ? "xz" : "") }' $< > $@
+
+# Tip paths: ball = normal offset by R lowered by R; square = flat bottom lowered onto the profile.
+# The plot shows the profile, the tool on the tip path and the gouges of the unoffset square end mill.
+$(SINE)/tip-%.csv $(SINE)/tip-%.svg $(SINE)/tip-%.json &: $(SINE)/profile-xz.csv $(RELEASE)/offset
+	$(RELEASE)/offset $< --profile $* --up z --radius $(SINE_TOOL_RADIUS) \
+	  --svg $(SINE)/tip-$*.svg --report $(SINE)/tip-$*.json -o $(SINE)/tip-$*.csv
+
+$(SINE)/tip-%.nc: $(SINE)/profile-xz.csv $(RELEASE)/offset
+	$(RELEASE)/offset $< --profile $* --up z --radius $(SINE_TOOL_RADIUS) --to gcode -o $@

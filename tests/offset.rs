@@ -267,6 +267,8 @@ fn pocket_with_an_island_passes_at_every_step_in_machining_order() {
         }
         seen.push((island, d));
     }
+    // Machining order: from the centre out, the wall passes last.
+    assert!(seen.windows(2).all(|w| w[0].1 >= w[1].1), "deepest first: {seen:?}");
     let mut ds: Vec<f64> = seen.iter().map(|s| s.1).collect();
     ds.sort_by(f64::total_cmp);
     ds.dedup_by(|a, b| (*a - *b).abs() < 1e-12);
