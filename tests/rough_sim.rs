@@ -135,11 +135,11 @@ fn brute_force_edge_points_never_lie_below() {
 
 #[test]
 fn output_does_not_depend_on_the_thread_count() {
-    let w = Work::new();
     let t = tool();
     let run = |threads: &str| {
         let out = std::process::Command::new(bin(BIN))
             .args(["patch", &t, "--pick", "0.5", "--feed-per-tooth", "0.5", "--step", "0.005", "--tilt", "3"])
+            .args(["--pass-phase", "90", "--picks", "3", "--teeth", "2"])
             .env("RAYON_NUM_THREADS", threads)
             .output()
             .unwrap();
@@ -147,7 +147,6 @@ fn output_does_not_depend_on_the_thread_count() {
         out.stdout
     };
     assert_eq!(run("1"), run("2"));
-    let _ = w;
 }
 
 /// A raster table: passes along +y at x = k·0.5, starting a whole number of turns before y = 0.

@@ -9,6 +9,7 @@ use camkit::table::{self, Col};
 use clap::{Args, Parser, Subcommand, ValueEnum};
 use rough_sim::cutter::{Cutter, Rotation};
 use rough_sim::patch::{Conditions, DEFAULT_MEMORY, Grid, simulate};
+use rough_sim::render::Series;
 use rough_sim::study::{self, CellFigures};
 use rough_sim::{brute, flat, render, zmap};
 use std::io::Write;
@@ -172,7 +173,7 @@ struct SweepArgs {
     /// Write the table here (default: standard output).
     #[arg(short = 'o', long = "output", value_name = "FILE")]
     output: Option<PathBuf>,
-    /// Write a plot of max height and remainder against the swept quantity.
+    /// Write a plot of the simulated highest point and the classic one against the swept quantity.
     #[arg(long, value_name = "FILE")]
     svg: Option<PathBuf>,
     /// Write the run's figures as JSON.
@@ -399,9 +400,9 @@ fn sweep(a: SweepArgs) -> Result<()> {
     let mut rows = vec![study::HEADER.to_string()];
     let mut series = Vec::new();
     let progress = Progress::new((radii.len() * a.values.len()) as u64, "sweeping");
-    for &r in &radii {
+    for (ri, &r) in radii.iter().enumerate() {
         positive(r, "--radii")?;
-        let mut pts_max = Vec::new();
+        let (mut pts_max, mut pts_classic) = (Vec::new(), Vec::new());
         for &v in &a.values {
             let mut cond = Conditions { cutter: Cutter { radius: r, ..base.cutter }, ..base };
             let mut spindle = speeds.map(|s| s.1);
@@ -425,10 +426,17 @@ fn sweep(a: SweepArgs) -> Result<()> {
             grid.check_memory(a.cond.max_memory.saturating_mul(1_000_000))?;
             let (_, figs) = study::cell(&cond, a.cond.step);
             rows.push(study::row(&cond, spindle, &figs));
-            pts_max.push((v, figs.map.max_height * 1e3));
+            pts_max.push((v, figs.peak.0 * 1e3));
+            pts_classic.push((v, figs.classic_peak * 1e3));
             progress.inc(1);
         }
-        series.push((format!("r = {r} mm: largest height"), pts_max));
+        series.push(Series { name: format!("r = {r} mm: simulated peak"), pts: pts_max, colour: ri, dashed: false });
+        series.push(Series {
+            name: format!("r = {r} mm: classic (cusp + feed scallop)"),
+            pts: pts_classic,
+            colour: ri,
+            dashed: true,
+        });
     }
     progress.finish();
     let x_label = match a.vary {
@@ -438,7 +446,8 @@ fn sweep(a: SweepArgs) -> Result<()> {
         Vary::PassPhase => "pass phase (°)",
     };
     if let Some(path) = &a.svg {
-        let svg = render::chart(&format!("largest height against {x_label}"), x_label, "height (µm)", &series);
+        let svg =
+            render::chart(&format!("roughness (highest point) against {x_label}"), x_label, "height (µm)", &series);
         write_atomic(path, svg.as_bytes())?;
     }
     if let Some(path) = &a.report {

@@ -66,18 +66,36 @@ pub fn colour_map(map: &HeightMap, title: &str, zero: f64) -> String {
     p.to_svg(900.0)
 }
 
+/// One line of a chart: its legend, points, colour slot and whether it is dashed.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Series {
+    /// Legend text.
+    pub name: String,
+    /// Points (x, y); non-finite y are left out.
+    pub pts: Vec<(f64, f64)>,
+    /// Colour slot: series of one radius share it.
+    pub colour: usize,
+    /// Dashed (the classic figures) or solid (the simulation).
+    pub dashed: bool,
+}
+
 /// A chart of series of (x, y) points with a legend.
-pub fn chart(title: &str, x_label: &str, y_label: &str, series: &[(String, Vec<(f64, f64)>)]) -> String {
+pub fn chart(title: &str, x_label: &str, y_label: &str, series: &[Series]) -> String {
     const COLOURS: [&str; 6] = ["#1f77b4", "#d62728", "#2ca02c", "#9467bd", "#ff7f0e", "#8c564b"];
     let mut p = Plot::new(title, Aspect::Free);
     p.labels(x_label, y_label);
-    p.include(P2::new(series.iter().flat_map(|s| s.1.iter().map(|q| q.0)).fold(f64::INFINITY, f64::min), 0.0));
-    for (k, (name, pts)) in series.iter().enumerate() {
-        let pts: Vec<P2> = pts.iter().filter(|q| q.1.is_finite()).map(|q| P2::new(q.0, q.1)).collect();
-        let style = Style::stroke(COLOURS[k % COLOURS.len()], 1.8);
+    p.include(P2::new(series.iter().flat_map(|s| s.pts.iter().map(|q| q.0)).fold(f64::INFINITY, f64::min), 0.0));
+    for s in series {
+        let pts: Vec<P2> = s.pts.iter().filter(|q| q.1.is_finite()).map(|q| P2::new(q.0, q.1)).collect();
+        let colour = COLOURS[s.colour % COLOURS.len()];
+        let mut style = Style::stroke(colour, if s.dashed { 1.2 } else { 1.8 });
+        if s.dashed {
+            style = style.dashed("6 4");
+        } else {
+            p.dots(&pts, 2.5, Style::fill(colour, 1.0));
+        }
         p.polyline(&pts, style.clone());
-        p.dots(&pts, 2.5, Style::fill(COLOURS[k % COLOURS.len()], 1.0));
-        p.legend(name, style);
+        p.legend(&s.name, style);
     }
     p.to_svg(800.0)
 }
