@@ -262,9 +262,8 @@ fn triangle_distance(q: &P3, a: &P3, b: &P3, c: &P3) -> f64 {
         .fold(f64::INFINITY, f64::min)
 }
 
-#[test]
-fn mesh_scan_never_comes_closer_than_r_by_brute_force() {
-    // A wavy height field with a steep ridge, 2 × 24 × 24 triangles, as binary STL.
+/// A wavy height field with a steep ridge, 2 × 24 × 24 triangles over 60 × 60 mm.
+fn wave() -> Vec<[P3; 3]> {
     let f = |i: usize, j: usize| {
         let (x, y) = (i as f64 * 2.5, j as f64 * 2.5);
         P3::new(x, y, 4.0 * (x / 9.0).sin() * (y / 13.0).cos() + if (25.0..35.0).contains(&x) { 6.0 } else { 0.0 })
@@ -276,22 +275,72 @@ fn mesh_scan_never_comes_closer_than_r_by_brute_force() {
             tris.push([f(i, j), f(i + 1, j + 1), f(i, j + 1)]);
         }
     }
+    tris
+}
+
+/// The triangles as the STL stores them (f32 corners).
+fn as_f32(tris: &[[P3; 3]]) -> Vec<[P3; 3]> {
+    let f = |p: &P3| P3::new(p.x as f32 as f64, p.y as f32 as f64, p.z as f32 as f64);
+    tris.iter().map(|t| [f(&t[0]), f(&t[1]), f(&t[2])]).collect()
+}
+
+/// Distance from `q` to the nearest of `tris`, by brute force.
+fn mesh_distance(q: &P3, tris: &[[P3; 3]]) -> f64 {
+    tris.iter().map(|[a, b, c]| triangle_distance(q, a, b, c)).fold(f64::INFINITY, f64::min)
+}
+
+#[test]
+fn ascii_stl_contours_at_several_levels_keep_r_from_the_mesh() {
+    let tris = as_f32(&wave());
+    // The same f32 corners as ASCII STL (shortest round-trip decimals).
+    let mut text = String::from("solid wave\n");
+    for t in &tris {
+        text.push_str("facet normal 0 0 0\n outer loop\n");
+        for p in t {
+            text.push_str(&format!("  vertex {} {} {}\n", p.x as f32, p.y as f32, p.z as f32));
+        }
+        text.push_str(" endloop\nendfacet\n");
+    }
+    text.push_str("endsolid wave\n");
+    let w = Work::new();
+    w.write("wave.stl", &text);
+    let binary = Work::new();
+    binary.write("wave.stl", camkit::model::mesh::binary_stl(&tris));
+    // Read as ASCII, the mesh gives the same scan as the binary file of the same corners.
+    for at in [&w, &binary] {
+        at.run(BIN, &["wave.stl", "-r", "2", "--pick", "6", "--zigzag", "-o", "scan.csv"], b"").ok();
+    }
+    let (ascii_scan, binary_scan) = (w.read("scan.csv"), binary.read("scan.csv"));
+    assert!(ascii_scan.lines().count() > 100 && ascii_scan == binary_scan, "ASCII and binary STL scans differ");
+    // Contour levels every 1.5 mm from the top down, inside the field.
+    w.run(
+        BIN,
+        &["wave.stl", "-r", "2", "--mode", "contour", "--z-step", "1.5", "--region", "5,55,5,55", "-o", "cl.csv"],
+        b"",
+    )
+    .ok();
+    let cl = rows(&w.read("cl.csv"));
+    let levels: std::collections::BTreeSet<i64> = cl.iter().map(|q| (q.c.z * 1e6).round() as i64).collect();
+    assert!(levels.len() >= 4, "{} levels", levels.len());
+    for path in 0..=cl.last().unwrap().path {
+        let l: Vec<&Cl> = cl.iter().filter(|q| q.path == path).collect();
+        assert!(l.iter().all(|q| q.c.z == l[0].c.z), "a contour stays at its level");
+    }
+    let worst = cl.iter().map(|q| (mesh_distance(&q.c, &tris) - 2.0).abs()).fold(0.0, f64::max);
+    assert!(worst <= CONTACT, "a contour point is {worst} mm off r from the mesh");
+}
+
+#[test]
+fn mesh_scan_never_comes_closer_than_r_by_brute_force() {
+    let tris = wave();
     let w = Work::new();
     w.write("wave.stl", camkit::model::mesh::binary_stl(&tris));
     w.run(BIN, &["wave.stl", "-r", "2.5", "--pick", "3", "--angle", "30", "-o", "cl.csv", "--report", "r.json"], b"")
         .ok();
     let cl = rows(&w.read("cl.csv"));
     assert!(cl.len() > 300);
-    // Corners as the STL stores them (f32).
-    let f32p = |p: &P3| P3::new(p.x as f32 as f64, p.y as f32 as f64, p.z as f32 as f64);
-    let mut worst_in: f64 = 0.0;
-    for q in &cl {
-        let d = tris
-            .iter()
-            .map(|[a, b, c]| triangle_distance(&q.c, &f32p(a), &f32p(b), &f32p(c)))
-            .fold(f64::INFINITY, f64::min);
-        worst_in = worst_in.max((d - 2.5).abs());
-    }
+    let stored = as_f32(&tris);
+    let worst_in = cl.iter().map(|q| (mesh_distance(&q.c, &stored) - 2.5).abs()).fold(0.0, f64::max);
     assert!(worst_in <= CONTACT, "a CL point is {worst_in} mm off r from the mesh");
     assert_eq!(report(&w, "r.json")["triangles"], 1152);
 }

@@ -20,7 +20,7 @@ pub fn trace_level(
     region: &Region,
     z: f64,
 ) -> Result<Vec<TracedPath>, Failure> {
-    let curve = PlaneCurve { model, stylus, plane_normal: V3::z() };
+    let curve = PlaneCurve { model, stylus, plane_normal: V3::z(), flat_moves: Some(stylus.radius * 0.25) };
     let r = stylus.radius;
     let mut loops: Vec<(Vec<CurvePoint>, f64)> = Vec::new();
     // Loops wholly behind the surface (inside a solid) are never written: only seeds in front

@@ -98,6 +98,12 @@ pub struct PlaneCurve<'a> {
     /// Unit normal of the motion plane; the tangent is `plane_normal × g`, g the in-plane part
     /// of L, so the material stays on one side.
     pub plane_normal: V3,
+    /// Where the offset surface is nearly parallel to the motion plane (|g| below [`MIN_SLOPE`]),
+    /// correct anyway along g, each move at most this long (mm), instead of giving up. Contour
+    /// levels near a flat spot need it; scan lines give up there (the stylus slides off a
+    /// sheet's side) and use `None`. The chord check of every step catches a move that lands on
+    /// another branch of the curve.
+    pub flat_moves: Option<f64>,
 }
 
 impl PlaneCurve<'_> {
@@ -144,13 +150,17 @@ impl Curve for PlaneCurve<'_> {
                 // by more than ~80°): correct along ΔR's own projection on the plane instead,
                 // the copying machine's two-dimensional correction.
                 let g = u - self.plane_normal * u.dot(&self.plane_normal);
-                if g.norm() < MIN_SLOPE {
+                let least = if self.flat_moves.is_some() { camkit::tol::LENGTH_EPS.sqrt() } else { MIN_SLOPE };
+                if g.norm() < least {
                     return None;
                 }
                 w = g.normalize();
                 slope = u.dot(&w);
             }
-            let moved = delta / slope;
+            let mut moved = delta / slope;
+            if let Some(cap) = self.flat_moves {
+                moved = moved.clamp(-cap, cap);
+            }
             c += w * moved;
             bound = n.distance + moved.abs() * (1.0 + 1e-9) + 1e-9;
         }

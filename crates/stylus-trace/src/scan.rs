@@ -84,7 +84,7 @@ pub fn lines(scan: &Scan) -> Vec<Line> {
 /// Traces one scan line; the passes it yields, in order. A pass ends at the region's end, where
 /// the model falls away (an overhang), or where the stylus cannot follow it (`interrupted`).
 pub fn trace_line(model: &Model, stylus: Stylus, steps: &Steps, line: &Line) -> Result<Vec<TracedPath>, Failure> {
-    let curve = PlaneCurve { model, stylus, plane_normal: V3::z().cross(&line.dir) };
+    let curve = PlaneCurve { model, stylus, plane_normal: V3::z().cross(&line.dir), flat_moves: None };
     let bounds = model.bounds();
     let (z_top, z_bottom) = if bounds.is_bounded() {
         (bounds.max.z + stylus.radius + 1.0, bounds.min.z - stylus.radius - 1.0)
