@@ -1,0 +1,347 @@
+//! `medial-trochoid`: engagement analysis of contour-parallel pocketing, danger regions on the
+//! medial axis, and trochoidal clearing of them first (paper 001).
+//!
+//! [`plan`] takes regions (outer boundary with islands), makes the contour-parallel passes with
+//! `camkit::contour::pocket`, simulates the material removal to get the exact engagement along
+//! them ([`engagement`]), finds where passes over the threshold meet the medial axis
+//! ([`medial`]), clears those stretches first with constant-radius trochoids ([`trochoid`]),
+//! re-simulates the whole program and estimates both programs' times ([`feed`]).
+
+pub mod angles;
+pub mod contours;
+pub mod engagement;
+pub mod feed;
+pub mod medial;
+pub mod plot;
+pub mod program;
+pub mod trochoid;
+
+use camkit::contour::OffsetOptions;
+use camkit::contour::pocket::{Direction, Pass, Passes, PocketOptions, pocket};
+use camkit::contour::region::Region;
+use camkit::geom::P2;
+use engagement::Cut;
+use feed::FeedModel;
+use medial::{Medial, MedialOptions, medial_axis};
+use program::{Program, Tag, clearance, point_clearance};
+use rayon::prelude::*;
+use std::collections::HashMap;
+
+/// Settings of a plan.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Settings {
+    /// Tool radius R (mm).
+    pub radius: f64,
+    /// Radial step over between passes (mm).
+    pub step: f64,
+    /// Engagement threshold (degrees).
+    pub threshold: f64,
+    /// Trochoid loop radius (mm).
+    pub trochoid_radius: f64,
+    /// Trochoid pitch (mm); `None` picks the largest that holds the threshold.
+    pub pitch: Option<f64>,
+    /// Material left on the walls (mm).
+    pub allowance: f64,
+    /// Engagement sample spacing along the path (mm).
+    pub sample: f64,
+    /// Medial axis settings.
+    pub medial: MedialOptions,
+    /// Feed model for the time estimate.
+    pub feed: FeedModel,
+}
+
+/// A program of one layer with its simulated engagement.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Analysed {
+    /// The moves.
+    pub program: Program,
+    /// Sample positions (move, fraction).
+    pub samples: Vec<(usize, f64)>,
+    /// Engagement at each sample (degrees).
+    pub engagement: Vec<f64>,
+    /// Feed (mm/min) at each sample (of the move up to it).
+    pub feeds: Vec<f64>,
+    /// Largest engagement over cutting moves (trochoids and passes, entries excluded).
+    pub max_cutting: f64,
+    /// Largest engagement over links.
+    pub max_link: f64,
+    /// Largest engagement over entries.
+    pub max_entry: f64,
+    /// Machining time of the layer (min) with the feed following the engagement sample by sample.
+    pub minutes: f64,
+    /// Machining time of the layer (min) with each kind of move at the feed its worst engagement allows.
+    pub minutes_constant: f64,
+    /// Smallest distance from the tool centre to the walls (mm).
+    pub wall_clearance: f64,
+}
+
+/// The result of [`plan`].
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Plan {
+    /// The regions.
+    pub regions: Vec<Region>,
+    /// Contour-parallel passes.
+    pub passes: Vec<Pass>,
+    /// Medial axis of each region.
+    pub medial: Vec<Medial>,
+    /// Offset-only program.
+    pub offset_only: Analysed,
+    /// Trochoids-first program.
+    pub trochoidal: Analysed,
+    /// Dangerous stretches of the medial axis (polylines).
+    pub danger: Vec<Vec<P2>>,
+    /// Stretches cleared by trochoids.
+    pub runs: Vec<Run>,
+    /// Dangerous stretches where no trochoid fits (polylines).
+    pub uncleared: Vec<Vec<P2>>,
+    /// Samples of the offset-only program over the threshold.
+    pub danger_samples: usize,
+}
+
+/// How many loop radii a plan tries: the given one and its halvings.
+const LEVELS: usize = 5;
+
+/// A stretch of the medial axis cleared by trochoids of one radius.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Run {
+    /// The stretch (polyline, mm).
+    pub points: Vec<P2>,
+    /// Loop radius (mm).
+    pub radius: f64,
+    /// Pitch (mm).
+    pub pitch: f64,
+}
+
+/// Why a plan could not be made.
+#[derive(Clone, Debug, PartialEq)]
+pub enum PlanError {
+    /// The pocket's offsets could not be verified.
+    Pocket(String),
+    /// The tool does not fit the region.
+    NoPasses,
+    /// The medial axis could not be built.
+    Medial(String),
+    /// No pitch keeps the trochoids under the threshold with this loop radius.
+    NoPitch,
+}
+
+impl std::fmt::Display for PlanError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            PlanError::Pocket(e) => write!(f, "pocket passes: {e}"),
+            PlanError::NoPasses => write!(f, "the tool does not fit in the pocket: no pass"),
+            PlanError::Medial(e) => write!(f, "medial axis: {e}"),
+            PlanError::NoPitch => write!(
+                f,
+                "no trochoid pitch keeps the engagement under the threshold: use a smaller --trochoid-radius or a larger --threshold"
+            ),
+        }
+    }
+}
+
+/// Simulates `program` for a tool of radius `r` and times it: feed moves of each kind run at
+/// the feed their worst engagement allows (entries at the slot feed).
+pub fn analyse(program: Program, s: &Settings, regions: &[Region]) -> Analysed {
+    let cut = Cut::new(s.radius, program.moves.iter().map(|m| m.seg).collect());
+    let samples = cut.samples(s.sample);
+    let engagement = cut.profile(&samples);
+    let mut worst: HashMap<Tag, f64> = HashMap::new();
+    for (&(i, _), &e) in samples.iter().zip(&engagement) {
+        let w = worst.entry(program.moves[i].tag).or_insert(0.0);
+        *w = w.max(e);
+    }
+    let get = |t: Tag| worst.get(&t).copied().unwrap_or(0.0);
+    let max_cutting = get(Tag::Trochoid).max(get(Tag::Contour));
+    // Two feed strategies: every sample at the feed its own engagement allows (the larger of
+    // the engagements at its two ends; air at the tool's largest feed per tooth), and each kind
+    // of move at one feed, the one its worst engagement allows. Entries ramp at the slot feed.
+    let mut feeds = Vec::with_capacity(samples.len());
+    let (mut minutes, mut minutes_constant) = (0.0, 0.0);
+    let mut before = (usize::MAX, 0.0, 0.0);
+    for (&(i, t), &e) in samples.iter().zip(&engagement) {
+        let m = &program.moves[i];
+        let (t0, e0) = if before.0 == i { (before.1, before.2) } else { (0.0, e) };
+        let (f, fc) = match m.tag {
+            Tag::Entry => (s.feed.feed(180.0), s.feed.feed(180.0)),
+            t => (s.feed.feed(e.max(e0)), s.feed.feed(get(t))),
+        };
+        let len = m.seg.length() * (t - t0);
+        minutes += len / f;
+        minutes_constant += len / fc;
+        feeds.push(f);
+        before = (i, t, e);
+    }
+    let wall_clearance = program
+        .moves
+        .iter()
+        .map(|m| regions.iter().map(|r| clearance(&m.seg, r)).fold(f64::INFINITY, f64::min))
+        .fold(f64::INFINITY, f64::min);
+    Analysed {
+        program,
+        samples,
+        engagement,
+        feeds,
+        max_cutting,
+        max_link: get(Tag::Link),
+        max_entry: get(Tag::Entry),
+        minutes,
+        minutes_constant,
+        wall_clearance,
+    }
+}
+
+/// The offset-only and the trochoids-first programs of `regions`.
+pub fn plan(regions: &[Region], s: &Settings) -> Result<Plan, PlanError> {
+    let wall = s.radius + s.allowance;
+    let opts = PocketOptions {
+        radius: wall,
+        step: s.step,
+        passes: Passes::UntilEmpty,
+        direction: Direction::Climb,
+        offset: OffsetOptions::default(),
+    };
+    let pocket =
+        pocket(regions, &opts).map_err(|e| PlanError::Pocket(format!("offset {} mm: {}", e.distance, e.error)))?;
+    if pocket.passes.is_empty() {
+        return Err(PlanError::NoPasses);
+    }
+    let mut passes_only = Program::default();
+    for (ri, region) in regions.iter().enumerate() {
+        let mine: Vec<Pass> = pocket.passes.iter().filter(|p| p.region == ri).cloned().collect();
+        passes_only.push_passes(&mine, region, wall);
+    }
+    let offset_only = analyse(passes_only.clone(), s, regions);
+    let medial: Vec<Medial> = regions
+        .iter()
+        .map(|r| medial_axis(r, &s.medial).map_err(|e| PlanError::Medial(e.to_string())))
+        .collect::<Result<_, _>>()?;
+    // Danger: medial points within a step over of a pass sample over the threshold.
+    let hot: Vec<P2> = offset_only
+        .samples
+        .iter()
+        .zip(&offset_only.engagement)
+        .filter(|(_, e)| **e > s.threshold)
+        .map(|(&(i, t), _)| offset_only.program.moves[i].seg.point_at(t))
+        .collect();
+    let reach = s.step.max(s.sample);
+    let grid = PointGrid::new(&hot, reach);
+    // Loop radii: the given one and halvings of it, so that runs reach into corners; each run
+    // keeps one radius, the largest that fits inside the clearance along it.
+    let radii: Vec<f64> = (0..LEVELS).map(|k| s.trochoid_radius / f64::from(1u32 << k)).collect();
+    let pitches: Vec<Option<f64>> = radii
+        .par_iter()
+        .map(|&rt| match s.pitch {
+            Some(p) => Some(p),
+            None => trochoid::pitch_for(s.radius, rt, s.threshold, s.sample.min(0.1)),
+        })
+        .collect();
+    if pitches[0].is_none() {
+        return Err(PlanError::NoPitch);
+    }
+    let mut danger = Vec::new();
+    let mut runs: Vec<Run> = Vec::new();
+    let mut uncleared = Vec::new();
+    let spacing = s.sample.min(0.5);
+    for (ri, m) in medial.iter().enumerate() {
+        for e in &m.edges {
+            let pts = densify(&e.points, spacing);
+            let flags: Vec<(bool, Option<usize>)> = pts
+                .iter()
+                .map(|p| {
+                    let hot = grid.any_within(p, reach);
+                    let cap = point_clearance(p, &regions[ri]) - wall + camkit::tol::OFFSET_TOL;
+                    (hot, (0..LEVELS).find(|&k| radii[k] <= cap && pitches[k].is_some()))
+                })
+                .collect();
+            danger.extend(stretches(&pts, &flags, |f| f.0));
+            uncleared.extend(stretches(&pts, &flags, |f| f.0 && f.1.is_none()));
+            for k in 0..LEVELS {
+                for points in stretches(&pts, &flags, |f| f.0 && f.1 == Some(k)) {
+                    runs.push(Run { points, radius: radii[k], pitch: pitches[k].expect("levels with a pitch") });
+                }
+            }
+        }
+    }
+    let mut troch = Program::default();
+    for run in &runs {
+        trochoid::push_trochoids(&mut troch, &run.points, run.radius, run.pitch);
+    }
+    let mut first = true;
+    for (ri, region) in regions.iter().enumerate() {
+        let mine: Vec<Pass> = pocket.passes.iter().filter(|p| p.region == ri).cloned().collect();
+        if first && !troch.moves.is_empty() {
+            // Start the passes with a retract: the trochoids end somewhere in the pocket.
+            let mut rest = Program::default();
+            rest.push_passes(&mine, region, wall);
+            if let Some(m) = rest.moves.first_mut() {
+                m.retract_before = true;
+            }
+            troch.moves.extend(rest.moves);
+        } else {
+            troch.push_passes(&mine, region, wall);
+        }
+        first = false;
+    }
+    let trochoidal = analyse(troch, s, regions);
+    Ok(Plan {
+        regions: regions.to_vec(),
+        passes: pocket.passes,
+        medial,
+        offset_only,
+        trochoidal,
+        danger,
+        runs,
+        uncleared,
+        danger_samples: hot.len(),
+    })
+}
+
+/// The polyline with points added so that none are more than `h` apart.
+fn densify(pts: &[P2], h: f64) -> Vec<P2> {
+    let mut out = vec![pts[0]];
+    for w in pts.windows(2) {
+        let n = ((w[1] - w[0]).norm() / h).ceil().max(1.0) as usize;
+        out.extend((1..=n).map(|k| w[0] + (w[1] - w[0]) * (k as f64 / n as f64)));
+    }
+    out
+}
+
+/// Maximal runs of consecutive points whose flags pass `keep` (runs of one point included).
+fn stretches<F: Copy>(pts: &[P2], flags: &[F], keep: impl Fn(F) -> bool) -> Vec<Vec<P2>> {
+    let mut out = Vec::new();
+    let mut cur: Vec<P2> = Vec::new();
+    for (p, &f) in pts.iter().zip(flags) {
+        if keep(f) {
+            cur.push(*p);
+        } else if !cur.is_empty() {
+            out.push(std::mem::take(&mut cur));
+        }
+    }
+    if !cur.is_empty() {
+        out.push(cur);
+    }
+    out
+}
+
+/// Points hashed on a grid for "is any within r" queries.
+struct PointGrid {
+    cell: f64,
+    map: HashMap<(i64, i64), Vec<P2>>,
+}
+
+impl PointGrid {
+    fn new(pts: &[P2], cell: f64) -> PointGrid {
+        let mut map: HashMap<(i64, i64), Vec<P2>> = HashMap::new();
+        for p in pts {
+            map.entry(((p.x / cell).floor() as i64, (p.y / cell).floor() as i64)).or_default().push(*p);
+        }
+        PointGrid { cell, map }
+    }
+
+    fn any_within(&self, p: &P2, r: f64) -> bool {
+        let (kx, ky) = ((p.x / self.cell).floor() as i64, (p.y / self.cell).floor() as i64);
+        (kx - 1..=kx + 1).any(|x| {
+            (ky - 1..=ky + 1).any(|y| self.map.get(&(x, y)).is_some_and(|v| v.iter().any(|q| (q - p).norm() <= r)))
+        })
+    }
+}

@@ -1,0 +1,381 @@
+//! `medial-trochoid`: engagement of contour-parallel pocketing, danger regions on the medial
+//! axis, trochoids first (paper 001).
+
+use camkit::cli::{self, IoArgs};
+use camkit::contour::Seg;
+use camkit::contour::region::{self, RegionError};
+use camkit::error::{Error, Location, Result};
+use camkit::geom::{P2, P3};
+use camkit::io::{Input, Output, write_atomic};
+use camkit::report::Report;
+use camkit::table::{self, Col, Move, Row, Schema, Table, WriteOptions};
+use clap::{Parser, ValueEnum};
+use medial_trochoid::feed::FeedModel;
+use medial_trochoid::medial::MedialOptions;
+use medial_trochoid::program::Tag;
+use medial_trochoid::{Analysed, Settings, contours, plan, plot};
+use std::path::PathBuf;
+use std::process::ExitCode;
+use std::time::Instant;
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+enum Which {
+    /// Trochoids along the danger regions first, then the offset passes.
+    Trochoid,
+    /// The contour-parallel passes alone (the reference).
+    Offset,
+}
+
+#[derive(Parser, Debug)]
+#[command(
+    name = "medial-trochoid",
+    version,
+    allow_negative_numbers = true,
+    about = "Engagement of contour-parallel pocketing, danger regions on the medial axis, trochoidal clearing first (paper 001).",
+    long_about = "Reads closed contours (outer boundaries and islands; lines and arcs) from the toolpath table, makes \
+contour-parallel pocket passes, simulates the material removal to get the exact 2D engagement angle along them, finds \
+where passes over the threshold meet the medial axis (segment Voronoi diagram without the edges at reflex vertices), \
+clears those stretches first with constant-radius trochoidal loops, re-simulates the whole program and estimates both \
+programs' machining time.",
+    after_help = after_help()
+)]
+struct Args {
+    #[command(flatten)]
+    io: IoArgs,
+    /// Tool radius R (mm).
+    #[arg(long, value_name = "MM")]
+    radius: f64,
+    /// Radial step over between passes (mm); default R(1 − cos threshold), the side cut at the threshold.
+    #[arg(long, value_name = "MM")]
+    step: Option<f64>,
+    /// Engagement threshold (degrees).
+    #[arg(long, default_value_t = 40.0, value_name = "DEG")]
+    threshold: f64,
+    /// Trochoid loop radius (mm); default R/2.
+    #[arg(long, value_name = "MM")]
+    trochoid_radius: Option<f64>,
+    /// Trochoid pitch (mm); default the largest whose simulated engagement holds the threshold.
+    #[arg(long, value_name = "MM")]
+    pitch: Option<f64>,
+    /// Material left on walls and islands (mm).
+    #[arg(long, default_value_t = 0.0, value_name = "MM")]
+    allowance: f64,
+    /// Engagement sample spacing along the path (mm); every move's end is also sampled.
+    #[arg(long, default_value_t = 0.5, value_name = "MM")]
+    sample: f64,
+    /// Number of layers (each the same 2D program, one layer depth lower).
+    #[arg(long, default_value_t = 1, value_name = "N")]
+    layers: usize,
+    /// Depth of each layer (mm): layer k is cut at z − k·depth, the contour's z being the first layer's bottom.
+    #[arg(long, default_value_t = 0.0, value_name = "MM")]
+    layer_depth: f64,
+    /// Which program to write.
+    #[arg(long, value_enum, default_value_t = Which::Trochoid)]
+    program: Which,
+    /// Snap grid of the Voronoi input (mm).
+    #[arg(long, default_value_t = 1e-6, value_name = "MM")]
+    resolution: f64,
+    /// Largest sagitta of the chords that replace arcs in the Voronoi input (mm).
+    #[arg(long, default_value_t = 1e-3, value_name = "MM")]
+    sagitta: f64,
+    /// Spindle speed for the time estimate (1/min).
+    #[arg(long, default_value_t = 4800.0, value_name = "RPM")]
+    spindle: f64,
+    /// Number of teeth.
+    #[arg(long, default_value_t = 6.0, value_name = "N")]
+    teeth: f64,
+    /// Largest chip thickness (mm): the feed per tooth is chip / sin(engagement), for engagement ≤ 90°.
+    #[arg(long, default_value_t = 0.03, value_name = "MM")]
+    chip: f64,
+    /// Largest feed per tooth of the tool (mm).
+    #[arg(long, default_value_t = 0.1, value_name = "MM")]
+    fz_max: f64,
+    /// Decimals of written positions (exact by default).
+    #[arg(long, value_name = "N")]
+    decimals: Option<u32>,
+    /// SVG of the written program: contours, medial axis, danger regions, passes coloured by engagement.
+    #[arg(long, value_name = "FILE")]
+    svg: Option<PathBuf>,
+    /// SVG of the other program (offset-only when writing trochoids, and the reverse).
+    #[arg(long, value_name = "FILE")]
+    svg_other: Option<PathBuf>,
+}
+
+fn after_help() -> String {
+    let mut s = table::columns::help_text(
+        &[Col::Path, Col::Move, Col::X, Col::Y, Col::Z, Col::Xc, Col::Yc, Col::Plane],
+        &[Col::Path, Col::Move, Col::X, Col::Y, Col::Z, Col::Xc, Col::Yc, Col::F, Col::Tag],
+    );
+    s.push_str("  engagement deg            engagement angle at the row's end (material-removal simulation)\n");
+    s.push_str("Each input path is one closed contour; nesting decides outer boundaries and islands.\n");
+    s.push_str(
+        "Output rows are samples along the tool-centre path (at most --sample mm apart); tag is entry (helical\n",
+    );
+    s.push_str("entry loop of a trochoid run), trochoid, contour or link; each chain starts with a rapid row.\n");
+    s.push_str("\nExit status: 0 done, 1 a check failed, 2 bad input or usage.");
+    s
+}
+
+fn main() -> ExitCode {
+    cli::run("medial-trochoid", || run(Args::parse()))
+}
+
+fn positive(v: f64, what: &str) -> Result<f64> {
+    if v.is_finite() && v > 0.0 {
+        Ok(v)
+    } else {
+        Err(Error::input(format!("{what} must be a positive number, got {v}")))
+    }
+}
+
+fn run(args: Args) -> Result<()> {
+    let started = Instant::now();
+    let r = positive(args.radius, "--radius")?;
+    let threshold = positive(args.threshold, "--threshold")?;
+    if threshold >= 180.0 {
+        return Err(Error::input("--threshold must be under 180 degrees"));
+    }
+    let step = positive(args.step.unwrap_or(r * (1.0 - threshold.to_radians().cos())), "--step")?;
+    let rt = positive(args.trochoid_radius.unwrap_or(0.5 * r), "--trochoid-radius")?;
+    if let Some(p) = args.pitch {
+        positive(p, "--pitch")?;
+    }
+    if !(args.allowance.is_finite() && args.allowance >= 0.0) {
+        return Err(Error::input(format!("--allowance must be zero or more, got {}", args.allowance)));
+    }
+    if !(args.layer_depth.is_finite() && args.layer_depth >= 0.0) || args.layers == 0 {
+        return Err(Error::input("--layers must be at least 1 and --layer-depth zero or more"));
+    }
+    if args.decimals.is_some_and(|d| d > 12) {
+        return Err(Error::input("--decimals must be at most 12"));
+    }
+    let settings = Settings {
+        radius: r,
+        step,
+        threshold,
+        trochoid_radius: rt,
+        pitch: args.pitch,
+        allowance: args.allowance,
+        sample: positive(args.sample, "--sample")?,
+        medial: MedialOptions {
+            resolution: positive(args.resolution, "--resolution")?,
+            sagitta: positive(args.sagitta, "--sagitta")?,
+            chord_error: positive(args.sagitta, "--sagitta")?,
+        },
+        feed: FeedModel {
+            spindle: positive(args.spindle, "--spindle")?,
+            teeth: positive(args.teeth, "--teeth")?,
+            chip: positive(args.chip, "--chip")?,
+            fz_max: positive(args.fz_max, "--fz-max")?,
+        },
+    };
+    let input = Input::open(&args.io.input)?;
+    let name = input.name.clone();
+    let table = table::read(&input, &[Col::X, Col::Y])?;
+    if table.rows.is_empty() {
+        return Err(Error::input("no rows: no contour to pocket").at(Location::file(&name)));
+    }
+    let sources = contours::read(&table, &name)?;
+    if sources.is_empty() {
+        return Err(Error::input("no closed contour in the input").at(Location::file(&name)));
+    }
+    if let Some(s) = sources.iter().find(|s| (s.z - sources[0].z).abs() > camkit::tol::POINT_EPS) {
+        return Err(
+            Error::input("the contours of a pocket lie at one z").at(Location::file(&name).line(s.line).field("z"))
+        );
+    }
+    let loops: Vec<_> = sources.iter().map(|s| s.contour.clone()).collect();
+    let (regions, _turned) = region::regions(&loops).map_err(|e| {
+        let i = match e {
+            RegionError::Open(i)
+            | RegionError::Degenerate(i)
+            | RegionError::SelfCrossing(i, _)
+            | RegionError::Crossing(i, _, _) => i,
+        };
+        Error::input(format!("path {}: {e}", sources[i].path)).at(Location::file(&name).line(sources[i].line))
+    })?;
+    let plan = plan(&regions, &settings).map_err(|e| match e {
+        medial_trochoid::PlanError::Pocket(_) => Error::check(e.to_string()),
+        _ => Error::input(e.to_string()).at(Location::file(&name)),
+    })?;
+    let chosen = if args.program == Which::Trochoid { &plan.trochoidal } else { &plan.offset_only };
+    let z0 = sources[0].z;
+    let out_table = to_table(chosen, z0, args.layers, args.layer_depth);
+    if !plan.uncleared.is_empty() {
+        cli::warn(&format!(
+            "{} dangerous stretches of the medial axis are too narrow for a trochoid of radius {rt} mm: left to the passes",
+            plan.uncleared.len()
+        ));
+    }
+    let mut out = Output::new(args.io.output.as_deref());
+    table::write(&mut out, &out_table, &WriteOptions { decimals: args.decimals })?;
+    let title = |a: &Analysed, what: &str| {
+        format!(
+            "{name}: {what}, largest engagement {:.1}° (threshold {threshold}°), {:.2} min per layer",
+            a.max_cutting, a.minutes
+        )
+    };
+    let (main_t, other_t) = if args.program == Which::Trochoid {
+        (title(&plan.trochoidal, "trochoids first"), title(&plan.offset_only, "offset passes only"))
+    } else {
+        (title(&plan.offset_only, "offset passes only"), title(&plan.trochoidal, "trochoids first"))
+    };
+    let troch_main = args.program == Which::Trochoid;
+    if let Some(path) = &args.svg {
+        write_atomic(path, plot::plan_plot(&main_t, &plan, troch_main).to_svg(1000.0).as_bytes())?;
+    }
+    if let Some(path) = &args.svg_other {
+        write_atomic(path, plot::plan_plot(&other_t, &plan, !troch_main).to_svg(1000.0).as_bytes())?;
+    }
+    if let Some(path) = &args.io.report {
+        let layers = args.layers as f64;
+        let (a, b) = (&plan.offset_only, &plan.trochoidal);
+        let medial_edges: usize = plan.medial.iter().map(|m| m.edges.len()).sum();
+        let mut rep = Report::new("medial-trochoid");
+        rep.set("program", if troch_main { "trochoid" } else { "offset" })
+            .set("radius_mm", r)
+            .set("step_mm", step)
+            .set("threshold_deg", threshold)
+            .set("allowance_mm", args.allowance)
+            .set("sample_mm", settings.sample)
+            .set("layers", args.layers)
+            .set("regions", regions.len())
+            .set("islands", regions.iter().map(|g| g.islands.len()).sum::<usize>())
+            .set("passes_per_layer", plan.passes.len())
+            .set("voronoi_segments", plan.medial.iter().map(|m| m.segments).sum::<usize>())
+            .set("voronoi_resolution_mm", settings.medial.resolution)
+            .set("arc_sagitta_mm", settings.medial.sagitta)
+            .set("medial_edges", medial_edges)
+            .set("medial_equidistance_error_mm", plan.medial.iter().map(|m| m.equidistance_error).fold(0.0, f64::max))
+            .set("danger_samples", plan.danger_samples)
+            .set("danger_stretches", plan.danger.len())
+            .set("trochoid_runs", plan.runs.len())
+            .set("uncleared_stretches", plan.uncleared.len())
+            .set("trochoid_radius_mm", rt)
+            .set("trochoid_radii_mm", runs_by(&plan, |r| r.radius))
+            .set("trochoid_pitches_mm", runs_by(&plan, |r| r.pitch))
+            .set("offset_only_largest_engagement_deg", a.max_cutting)
+            .set("offset_only_link_engagement_deg", a.max_link)
+            .set("largest_engagement_deg", b.max_cutting)
+            .set("link_engagement_deg", b.max_link)
+            .set("entry_engagement_deg", b.max_entry)
+            .set("threshold_held", b.max_cutting <= threshold)
+            .set("smallest_wall_clearance_mm", b.wall_clearance)
+            .set("no_gouge", b.wall_clearance >= r + args.allowance - camkit::tol::OFFSET_TOL)
+            .set("offset_only_minutes", a.minutes_constant * layers)
+            .set("offset_only_variable_feed_minutes", a.minutes * layers)
+            .set("trochoidal_minutes", b.minutes * layers)
+            .set("trochoidal_constant_feed_minutes", b.minutes_constant * layers)
+            .set("time_ratio", b.minutes / a.minutes_constant)
+            .set("offset_only_length_mm", a.program.moves.iter().map(|m| m.seg.length()).sum::<f64>() * layers)
+            .set("trochoid_length_mm", (b.program.length(Tag::Trochoid) + b.program.length(Tag::Entry)) * layers)
+            .set("contour_length_mm", b.program.length(Tag::Contour) * layers)
+            .set("offset_only_feed_mm_min", s_feed(a, Tag::Contour))
+            .set("trochoid_feed_min_mm_min", s_feed(b, Tag::Trochoid))
+            .set("contour_feed_mm_min", s_feed(b, Tag::Contour))
+            .set("output_rows", out_table.rows.len())
+            .set("seconds", started.elapsed().as_secs_f64());
+        rep.write(path)?;
+    }
+    out.commit()
+}
+
+/// Slowest feed of the samples of moves with `tag` (0 if none).
+fn s_feed(a: &Analysed, tag: Tag) -> f64 {
+    a.samples
+        .iter()
+        .zip(&a.feeds)
+        .filter(|((i, _), _)| a.program.moves[*i].tag == tag)
+        .map(|(_, f)| *f)
+        .reduce(f64::min)
+        .unwrap_or(0.0)
+}
+
+/// The distinct values of `f` over the plan's trochoid runs, in first-seen order.
+fn runs_by(plan: &medial_trochoid::Plan, f: impl Fn(&medial_trochoid::Run) -> f64) -> Vec<f64> {
+    let mut out: Vec<f64> = Vec::new();
+    for r in &plan.runs {
+        let v = f(r);
+        if !out.contains(&v) {
+            out.push(v);
+        }
+    }
+    out
+}
+
+/// For each move, where it starts along its helical entry loop and how much of the loop it
+/// is (fractions of the loop's length; zeros for other moves).
+fn helix_fractions(a: &Analysed) -> Vec<(f64, f64)> {
+    let moves = &a.program.moves;
+    let mut out = vec![(0.0, 0.0); moves.len()];
+    let mut i = 0;
+    while i < moves.len() {
+        if moves[i].tag != Tag::Entry {
+            i += 1;
+            continue;
+        }
+        let mut j = i + 1;
+        while j < moves.len() && moves[j].tag == Tag::Entry && !moves[j].retract_before {
+            j += 1;
+        }
+        let total: f64 = moves[i..j].iter().map(|m| m.seg.length()).sum();
+        let mut cum = 0.0;
+        for k in i..j {
+            let l = moves[k].seg.length() / total;
+            out[k] = (cum, l);
+            cum += l;
+        }
+        i = j;
+    }
+    out
+}
+
+/// The program as table rows: one row per sample, a rapid row where a chain starts, repeated
+/// for every layer.
+fn to_table(a: &Analysed, z0: f64, layers: usize, depth: f64) -> Table {
+    let mut t = Table {
+        schema: Schema::of(&[Col::Path, Col::Move, Col::X, Col::Y, Col::Z, Col::Xc, Col::Yc, Col::F, Col::Tag]),
+        rows: Vec::new(),
+    };
+    let k = t.add_extra_column("engagement");
+    let helix = helix_fractions(a);
+    let mut path = 0i64;
+    for layer in 0..layers {
+        let z = z0 - layer as f64 * depth;
+        let mut last_t = 0.0;
+        let mut last_i = usize::MAX;
+        for (k_sample, (&(i, tt), &e)) in a.samples.iter().zip(&a.engagement).enumerate() {
+            let m = &a.program.moves[i];
+            if i != last_i {
+                last_t = 0.0;
+                if m.retract_before {
+                    path += 1;
+                    let s = m.seg.start();
+                    let top = if m.tag == Tag::Entry { z + depth } else { z };
+                    let mut row = Row::at(path, P3::new(s.x, s.y, top));
+                    row.mv = Move::Rapid;
+                    row.tag = m.tag.name().into();
+                    row.extra = vec![String::new(); k + 1];
+                    t.rows.push(row);
+                }
+                last_i = i;
+            }
+            let piece = m.seg.sub(last_t, tt);
+            let q = piece.end();
+            let (f0, df) = helix[i];
+            let zq = if m.tag == Tag::Entry { z + depth * (1.0 - f0 - df * tt) } else { z };
+            let mut row = Row::at(path, P3::new(q.x, q.y, zq));
+            if let Seg::Arc(arc) = piece {
+                row.mv = if arc.ccw() { Move::Ccw } else { Move::Cw };
+                row.centre = Some(P2::new(arc.c.x, arc.c.y));
+            }
+            row.f = Some(a.feeds[k_sample]);
+            row.tag = m.tag.name().into();
+            row.extra = vec![String::new(); k + 1];
+            row.extra[k] = format!("{e:.3}");
+            t.rows.push(row);
+            last_t = tt;
+        }
+    }
+    t
+}

@@ -1,0 +1,107 @@
+//! End-to-end tests of `medial-trochoid`: pockets from `data/medial-trochoid` through the built
+//! binary, engagement checked against closed forms, bad input refused with one clear line.
+
+use e2e::{Work, data};
+
+const BIN: &str = "medial-trochoid";
+
+fn report(w: &Work, name: &str) -> serde_json::Value {
+    serde_json::from_str(&w.read(name)).expect("report is JSON")
+}
+
+/// Rows of the output table as (tag, engagement, x, y) with the header's column order.
+fn rows(csv: &str) -> Vec<(String, Option<f64>, f64, f64)> {
+    let mut lines = csv.lines();
+    let header: Vec<&str> = lines.next().expect("header").split(',').collect();
+    let col = |n: &str| header.iter().position(|h| *h == n).unwrap_or_else(|| panic!("column {n}"));
+    let (t, e, x, y) = (col("tag"), col("engagement"), col("x"), col("y"));
+    lines
+        .map(|l| {
+            let v: Vec<&str> = l.split(',').collect();
+            (v[t].to_string(), v[e].parse().ok(), v[x].parse().unwrap(), v[y].parse().unwrap())
+        })
+        .collect()
+}
+
+#[test]
+fn square_pocket_engagement_meets_closed_forms_and_trochoids_lower_it() {
+    let w = Work::new();
+    let src = data("medial-trochoid/square.csv");
+    let args = [src.to_str().unwrap(), "--radius", "5", "--sample", "0.5", "--report", "r.json", "-o", "t.csv"];
+    w.run(BIN, &args, b"").ok();
+    let r = report(&w, "r.json");
+    let f = |k: &str| r[k].as_f64().unwrap_or_else(|| panic!("{k} in {r}"));
+    // The innermost pass of the offset-only program is a slot: exactly 180°.
+    assert!((f("offset_only_largest_engagement_deg") - 180.0).abs() < 1e-6);
+    assert!(f("largest_engagement_deg") < f("offset_only_largest_engagement_deg"));
+    assert_eq!(r["no_gouge"], true);
+    assert!((f("smallest_wall_clearance_mm") - 5.0).abs() < 1e-6);
+    assert!(f("medial_equidistance_error_mm") < 1e-6);
+    assert_eq!(r["medial_edges"], 5);
+    // Default step R(1 − cos 40°): straight side cuts of the passes are at 40° exactly.
+    let out = rows(&w.read("t.csv"));
+    let side_cuts =
+        out.iter().filter(|(t, e, ..)| t == "contour" && e.is_some_and(|e| (e - 40.0).abs() < 1e-3)).count();
+    assert!(side_cuts > 500, "{side_cuts} rows at 40°");
+    // Every trochoid loop holds the threshold (its pitch was chosen by simulation).
+    let worst = out.iter().filter(|(t, ..)| t == "trochoid").filter_map(|r| r.1).fold(0.0, f64::max);
+    assert!(worst <= 40.0 + 0.5, "trochoid engagement {worst}");
+    assert!(out.iter().any(|(t, ..)| t == "entry") && out.iter().any(|(t, ..)| t == "link"));
+    // The offset-only program is also written on request, and its slot is there.
+    w.run(BIN, &[src.to_str().unwrap(), "--radius", "5", "--program", "offset", "-o", "o.csv"], b"").ok();
+    let off = rows(&w.read("o.csv"));
+    assert!(off.iter().all(|(t, ..)| t != "trochoid"));
+    assert!(off.iter().filter_map(|r| r.1).any(|e| (e - 180.0).abs() < 1e-9));
+}
+
+#[test]
+fn island_pocket_keeps_clear_of_the_island() {
+    let w = Work::new();
+    let src = data("medial-trochoid/island.csv");
+    let args = [
+        src.to_str().unwrap(),
+        "--radius",
+        "3",
+        "--sample",
+        "1",
+        "--report",
+        "r.json",
+        "--svg",
+        "p.svg",
+        "-o",
+        "t.csv",
+    ];
+    w.run(BIN, &args, b"").ok();
+    let r = report(&w, "r.json");
+    assert_eq!(r["islands"], 1);
+    assert_eq!(r["no_gouge"], true);
+    assert!(r["smallest_wall_clearance_mm"].as_f64().unwrap() >= 3.0 - 1e-6);
+    let out = rows(&w.read("t.csv"));
+    for (_, _, x, y) in &out {
+        // Tool centre never within R of the island (24..36 × 16..24).
+        let dx = (24.0 - x).max(x - 36.0).max(0.0);
+        let dy = (16.0 - y).max(y - 24.0).max(0.0);
+        assert!(dx.hypot(dy) >= 3.0 - 1e-6, "({x}, {y})");
+    }
+    assert!(w.read("p.svg").contains("<svg"));
+}
+
+#[test]
+fn bad_input_is_refused_with_its_place() {
+    let w = Work::new();
+    w.write("open.csv", "path,move,x,y,z\n1,rapid,0,0,0\n1,line,10,0,0\n1,line,10,10,0\n");
+    w.run(BIN, &["open.csv", "--radius", "1"], b"").fails(2, "open.csv:4");
+    w.write("text.csv", "path,move,x,y,z\n1,rapid,0,0,0\n1,line,ten,0,0\n");
+    w.run(BIN, &["text.csv", "--radius", "1"], b"").fails(2, "text.csv:3");
+    let cross = "path,move,x,y,z\n1,rapid,0,0,0\n1,line,10,0,0\n1,line,10,10,0\n1,line,0,10,0\n1,line,0,0,0\n\
+                 2,rapid,5,5,0\n2,line,15,5,0\n2,line,15,15,0\n2,line,5,15,0\n2,line,5,5,0\n";
+    w.write("cross.csv", cross);
+    w.run(BIN, &["cross.csv", "--radius", "1"], b"").fails(2, "cross.csv:2");
+    let sq = data("medial-trochoid/square.csv");
+    w.run(BIN, &[sq.to_str().unwrap(), "--radius", "30"], b"").fails(2, "does not fit");
+    w.run(BIN, &[sq.to_str().unwrap(), "--radius", "-1"], b"").fails(2, "--radius");
+    w.write("empty.csv", "");
+    let out = w.run(BIN, &["empty.csv", "--radius", "1", "-o", "never.csv"], b"");
+    assert_eq!(out.status, 2, "{}", out.stderr);
+    assert!(!w.exists("never.csv"));
+}
