@@ -115,8 +115,11 @@ pub fn fit_program(
                 _ => break,
             }
         }
-        let mut pts = vec![head.start];
-        let mut from = vec![k];
+        // At most one point per block of the run, plus its start: reserve once, not per push.
+        let mut pts = Vec::with_capacity(end + 2 - k);
+        let mut from = Vec::with_capacity(end + 2 - k);
+        pts.push(head.start);
+        from.push(k);
         for (i, m) in moves.iter().enumerate().take(end + 1).skip(k) {
             let Some(m) = m else { continue };
             if push_distinct(&mut pts, m.end) {
