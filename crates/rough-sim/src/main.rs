@@ -335,6 +335,7 @@ fn patch(a: PatchArgs) -> Result<()> {
     let progress = Progress::new(1, "simulating");
     let map = simulate(&cond, &grid);
     progress.finish();
+    let simulate_seconds = started.elapsed().as_secs_f64();
     let figs = study::cell_figures(&cond, &map);
     let seconds = started.elapsed().as_secs_f64();
     let mut report = Report::new("rough-sim");
@@ -342,7 +343,10 @@ fn patch(a: PatchArgs) -> Result<()> {
     set_conditions(&mut report, &cond);
     report.set("grid_step_mm", step).set("nodes", grid.nx * grid.ny);
     set_figures(&mut report, &figs);
-    report.set("seconds", seconds).set("nodes_per_second", (grid.nx * grid.ny) as f64 / seconds.max(1e-9));
+    report
+        .set("seconds", seconds)
+        .set("simulate_seconds", simulate_seconds)
+        .set("nodes_per_second", (grid.nx * grid.ny) as f64 / simulate_seconds.max(1e-9));
     if a.verify {
         let area = (-cond.pick / 2.0, cond.pick / 2.0, 0.0, cond.feed_per_tooth);
         let max_radial = (2.0 * cond.cutter.radius * (figs.map.max_height + 0.01)).sqrt().min(cond.cutter.radius);
