@@ -342,6 +342,16 @@ fn mesh_scan_never_comes_closer_than_r_by_brute_force() {
     let stored = as_f32(&tris);
     let worst_in = cl.iter().map(|q| (mesh_distance(&q.c, &stored) - 2.5).abs()).fold(0.0, f64::max);
     assert!(worst_in <= CONTACT, "a CL point is {worst_in} mm off r from the mesh");
+    // Inside every chord, | distance to the mesh − r | is a lower bound of the distance to the
+    // true CL curve (distance is 1-Lipschitz): it must stay within the chord tolerance.
+    let mut worst_chord: f64 = 0.0;
+    for q in cl.windows(2).filter(|q| q[0].path == q[1].path) {
+        for f in [0.25, 0.5, 0.75] {
+            let m = q[0].c + (q[1].c - q[0].c) * f;
+            worst_chord = worst_chord.max((mesh_distance(&m, &stored) - 2.5).abs());
+        }
+    }
+    assert!(worst_chord <= 0.001, "a chord strays {worst_chord} mm from the CL curve");
     assert_eq!(report(&w, "r.json")["triangles"], 1152);
 }
 
