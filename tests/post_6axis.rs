@@ -237,6 +237,43 @@ fn every_machine_family_posts_and_reads_back() {
             assert!(nc.contains("G43.4 H1") && !nc.contains("G93"), "{name}: TCP mode, feed per minute");
             assert!(nc.contains("N10 "), "{name}: block numbers");
         }
+        // Set-up words before the first motion, their switching off after the last, in order.
+        let at = |word: &str| nc.find(word).unwrap_or_else(|| panic!("{name}: no {word:?} in\n{nc}"));
+        let first_move = at("G0 X");
+        // Offset of the last motion block: a line (block number aside) starting with a motion or axis word.
+        let mut last_move = first_move;
+        let mut offset = 0;
+        for line in nc.split_inclusive('\n') {
+            let body = line.trim_start_matches(|c: char| c == 'N' || c.is_ascii_digit() || c == ' ');
+            if ["G0 ", "G1", "G93", "X", "Y", "Z", "A", "B", "C"].iter().any(|w| body.starts_with(w)) {
+                last_move = offset;
+            }
+            offset += line.len();
+        }
+        let (setup, closing): (&[&str], &[&str]) = match name {
+            "paper002-ac.json" => {
+                (&["G21 ", "G54", "G53 G0 Z0", "T1 M6", "G43 H1", "S12000 M3", "M8"], &["M9", "M5", "G49"])
+            }
+            "paper002-ac-fanuc-tcp.json" => {
+                (&["O2002", "G21 ", "G54", "T1 M6", "G43.4 H1", "S12000 M3", "M8"], &["M9", "M5", "G49"])
+            }
+            "table-bc-fanuc.json" => {
+                (&["O0001", "G21 ", "G54", "T3 M6", "G43 H3", "S8000 M3", "M7"], &["M9", "M5", "G49"])
+            }
+            _ => (&["G21 ", "G54"], &[]),
+        };
+        let mut prev = 0;
+        for word in setup {
+            let k = at(word);
+            assert!(k >= prev && k < first_move, "{name}: {word} out of order in the header");
+            prev = k;
+        }
+        for word in closing {
+            assert!(nc.rfind(word).unwrap_or(0) > last_move, "{name}: {word} after the last move");
+        }
+        if name == "table-bc-fanuc.json" {
+            assert!(!nc.contains("G53"), "{name}: no retract_z, no G53 move");
+        }
     }
     // A flat pass for the three-axis machine; a tilted axis is refused there.
     let flat: Vec<Row> = (0..50)

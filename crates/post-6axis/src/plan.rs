@@ -5,7 +5,7 @@
 //! tool axis within `angle_tol` of the great-circle arc between the end axes.
 
 use camkit::geom::{P3, V3};
-use camkit::kinematics::{Chain, Joints, Solver, principal_deg};
+use camkit::kinematics::{Chain, Joints, M3, Solver, principal_deg};
 
 /// One CL row as the post needs it.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -135,9 +135,15 @@ impl Machine<'_> {
 
     /// Controller spindle angle for CL orientation `s` at rotary angles `rot`, near `prev`.
     fn spindle(&self, rot: &[f64; 2], s: Option<f64>, prev: Option<f64>) -> Option<f64> {
+        self.spindle?;
+        self.spindle_in(&self.chain().orientation(rot), s, prev)
+    }
+
+    /// [`Machine::spindle`] for a tool frame orientation already known.
+    fn spindle_in(&self, frame: &M3, s: Option<f64>, prev: Option<f64>) -> Option<f64> {
         let sp = self.spindle?;
         let s = s?;
-        let a = sp.offset + sp.sense * self.chain().spindle_angle(rot, s);
+        let a = sp.offset + sp.sense * Chain::spindle_angle_in(frame, s);
         Some(match prev {
             Some(p) => p + principal_deg(a - p),
             None => principal_deg(a),
@@ -155,13 +161,14 @@ impl Machine<'_> {
         Ok(())
     }
 
-    /// Tip, axis and spindle angle the controller is at for joints `q` and spindle `sigma`.
-    fn at(&self, q: &Joints, tcp: bool) -> (P3, V3) {
+    /// Tip, axis and tool frame orientation the controller is at for joints `q`.
+    fn at(&self, q: &Joints, tcp: bool) -> (P3, V3, M3) {
         if tcp {
-            (P3::from(q.xyz), self.chain().orientation(&q.rot).column(2).into_owned())
+            let m = self.chain().orientation(&q.rot);
+            (P3::from(q.xyz), m.column(2).into_owned(), m)
         } else {
-            let p = self.chain().forward(q);
-            (p.tip, p.axis)
+            let (p, m) = self.chain().forward_oriented(q);
+            (p.tip, p.axis, m)
         }
     }
 }
@@ -340,13 +347,13 @@ fn segment_deviation(m: &Machine, opts: &Options, a: &Step, b: &Step, samples: &
     let (mut dt, mut da, mut ds) = (0.0f64, 0.0f64, 0.0f64);
     for &t in samples {
         let q = lerp_joints(&a.joints, &b.joints, t);
-        let (tip, axis) = m.at(&q, opts.tcp);
+        let (tip, axis, frame) = m.at(&q, opts.tcp);
         dt = dt.max(point_segment(&tip, &a.cl.tip, &b.cl.tip));
         da = da.max(vector_arc(&axis, &axis_a, &axis_b));
         if let (Some(sa), Some(sb), Some(ca), Some(cb)) = (a.spindle, b.spindle, a.cl.s, b.cl.s) {
             let sp = m.spindle.expect("spindle angles need a spindle");
             let want_s = ca + principal_deg(cb - ca) * t;
-            let want = m.spindle(&q.rot, Some(want_s), Some(sa + (sb - sa) * t)).unwrap_or(0.0);
+            let want = m.spindle_in(&frame, Some(want_s), Some(sa + (sb - sa) * t)).unwrap_or(0.0);
             let have = if sp.interpolated { sa + (sb - sa) * t } else { sb };
             ds = ds.max(principal_deg(have - want).abs());
         }

@@ -154,6 +154,10 @@ pub fn rotation(d: &V3, angle: f64) -> M3 {
 
 /// `angle` (degrees) reduced to (−180, 180].
 pub fn principal_deg(angle: f64) -> f64 {
+    // Most angles are principal already: skip the division (a hot path of the post).
+    if angle > -180.0 && angle <= 180.0 {
+        return angle;
+    }
     let a = angle.rem_euclid(360.0);
     if a > 180.0 { a - 360.0 } else { a }
 }
@@ -285,21 +289,31 @@ impl Chain {
     /// The orientation of the tool frame in the workpiece frame: the product of the chain's
     /// rotations, left to right. The tool axis is its third column.
     pub fn orientation(&self, rot: &[f64; 2]) -> M3 {
-        let mut m = M3::identity();
+        self.orientation_of(&self.rotations(rot))
+    }
+
+    /// The rotation of each rotary axis at `rot` (identity for unused entries): computed once per
+    /// pose, as trigonometry dominates the cost of the kinematics.
+    fn rotations(&self, rot: &[f64; 2]) -> [M3; 2] {
+        let mut m = [M3::identity(); 2];
         for (k, r) in self.rotaries.iter().enumerate() {
-            m *= rotation(&r.dir, self.angle_rad(k, rot));
+            m[k] = rotation(&r.dir, self.angle_rad(k, rot));
         }
         m
     }
 
+    fn orientation_of(&self, rots: &[M3; 2]) -> M3 {
+        rots[..self.rotaries.len()].iter().fold(M3::identity(), |m, r| m * r)
+    }
+
     /// The table side `(R, t)` (workpiece ← machine: `p_w = R p_m + t`, frame included) and the
     /// tool tip in machine coordinates relative to `(x, y, z)` (the head side applied to the tip).
-    fn sides(&self, rot: &[f64; 2]) -> (M3, V3, V3) {
+    fn sides(&self, rots: &[M3; 2]) -> (M3, V3, V3) {
         let mut r = M3::identity();
         let mut t = self.frame;
         for link in &self.links[..self.linear_at] {
             match link {
-                Link::Rotary(k) => r *= rotation(&self.rotaries[*k].dir, self.angle_rad(*k, rot)),
+                Link::Rotary(k) => r *= rots[*k],
                 Link::Offset(v) => t += r * v,
                 Link::Linear => {}
             }
@@ -307,7 +321,7 @@ impl Chain {
         let mut h = V3::zeros();
         for link in self.links[self.linear_at + 1..].iter().rev() {
             match link {
-                Link::Rotary(k) => h = rotation(&self.rotaries[*k].dir, self.angle_rad(*k, rot)) * h,
+                Link::Rotary(k) => h = rots[*k] * h,
                 Link::Offset(v) => h += v,
                 Link::Linear => {}
             }
@@ -317,16 +331,23 @@ impl Chain {
 
     /// Forward kinematics: tool tip and axis in the workpiece frame for controller values.
     pub fn forward(&self, j: &Joints) -> Pose {
-        let (r, t, h) = self.sides(&j.rot);
+        self.forward_oriented(j).0
+    }
+
+    /// Forward kinematics with the tool frame's orientation (its third column is the axis), for
+    /// callers that also need the spindle angle ([`Chain::spindle_angle_in`]) at the same pose.
+    pub fn forward_oriented(&self, j: &Joints) -> (Pose, M3) {
+        let rots = self.rotations(&j.rot);
+        let (r, t, h) = self.sides(&rots);
         let tip = P3::from(r * (j.xyz + h) + t);
-        let axis = self.orientation(&j.rot).column(2).into_owned();
-        Pose { tip, axis }
+        let m = self.orientation_of(&rots);
+        (Pose { tip, axis: m.column(2).into_owned() }, m)
     }
 
     /// The linear axes that put the tool tip at `tip` (workpiece frame) with rotary angles `rot`:
     /// the inverse of eq. 2 once the angles are known.
     pub fn linear_for(&self, tip: &P3, rot: &[f64; 2]) -> V3 {
-        let (r, t, h) = self.sides(rot);
+        let (r, t, h) = self.sides(&self.rotations(rot));
         r.transpose() * (tip.coords - t) - h
     }
 
@@ -414,7 +435,12 @@ impl Chain {
     /// spindle orientation `s` (degrees, about the tool axis, see [`spindle_reference`]) when the
     /// rotary axes are at `rot`. The spindle's zero is the tool frame's +X.
     pub fn spindle_angle(&self, rot: &[f64; 2], s_deg: f64) -> f64 {
-        let m = self.orientation(rot);
+        Self::spindle_angle_in(&self.orientation(rot), s_deg)
+    }
+
+    /// [`Chain::spindle_angle`] for a tool frame orientation `m` already known
+    /// ([`Chain::orientation`], [`Chain::forward_oriented`]).
+    pub fn spindle_angle_in(m: &M3, s_deg: f64) -> f64 {
         let axis = m.column(2).into_owned();
         let edge = m.transpose() * edge_direction(&axis, s_deg);
         edge.y.atan2(edge.x).to_degrees()
