@@ -14,11 +14,12 @@ ROUGHNESS_PHASE ?= 90
 ROUGHNESS_STEP ?= 0.002
 ROUGHNESS_SWEEP_STEP ?= 0.004
 ROUGHNESS_FLAT ?= 0.5
+ROUGHNESS_FLAT_SHORT ?= 0.3
 ROUGHNESS_FEED ?= 2000
 ROUGHNESS_COND = --pick $(ROUGHNESS_PICK) --lean $(ROUGHNESS_LEAN) --pass-phase $(ROUGHNESS_PHASE)
 
 .PHONY: demo-roughness
-demo-roughness: $(foreach t,0 3 10,$(ROUGHNESS)/fig2-tilt$(t).csv) $(ROUGHNESS)/flat-tip.csv $(ROUGHNESS)/fig7-flat.csv \
+demo-roughness: $(foreach t,0 3 10,$(ROUGHNESS)/fig2-tilt$(t).csv) $(ROUGHNESS)/flat-tip.csv $(ROUGHNESS)/fig7-flat.csv $(ROUGHNESS)/fig7-flat-short.csv \
   $(ROUGHNESS)/fig4b-feed.csv $(ROUGHNESS)/fig5b-tilt.csv $(ROUGHNESS)/spindle.csv $(ROUGHNESS)/raster-zmap.csv
 
 # Fig. 2 / fig. 5a: one periodic cell (pick feed × feed per tooth), heights, colour map, the
@@ -36,6 +37,11 @@ $(ROUGHNESS)/flat-tip.csv $(ROUGHNESS)/flat-tip.json &: $(ROUGHNESS_TOOL) $(RELE
 $(ROUGHNESS)/fig7-flat.csv $(ROUGHNESS)/fig7-flat.svg $(ROUGHNESS)/fig7-flat.json &: $(ROUGHNESS_TOOL) $(RELEASE)/rough-sim | $(ROUGHNESS)/
 	$(RELEASE)/rough-sim patch $< $(ROUGHNESS_COND) --feed-per-tooth $(ROUGHNESS_FZ) --flat-radius $(ROUGHNESS_FLAT) --step $(ROUGHNESS_STEP) \
 	  --svg $(ROUGHNESS)/fig7-flat.svg --report $(ROUGHNESS)/fig7-flat.json -o $(ROUGHNESS)/fig7-flat.csv
+
+# Fig. 7(b): a flat shorter than eq. 7's (r' < r0) leaves part of the remainder.
+$(ROUGHNESS)/fig7-flat-short.csv $(ROUGHNESS)/fig7-flat-short.svg $(ROUGHNESS)/fig7-flat-short.json &: $(ROUGHNESS_TOOL) $(RELEASE)/rough-sim | $(ROUGHNESS)/
+	$(RELEASE)/rough-sim patch $< $(ROUGHNESS_COND) --feed-per-tooth $(ROUGHNESS_FZ) --flat-radius $(ROUGHNESS_FLAT_SHORT) --step $(ROUGHNESS_STEP) \
+	  --svg $(ROUGHNESS)/fig7-flat-short.svg --report $(ROUGHNESS)/fig7-flat-short.json -o $(ROUGHNESS)/fig7-flat-short.csv
 
 # Fig. 4b: roughness against feed per tooth, r = 5, 10, 15 mm.
 $(ROUGHNESS)/fig4b-feed.csv $(ROUGHNESS)/fig4b-feed.svg &: $(ROUGHNESS_TOOL) $(RELEASE)/rough-sim | $(ROUGHNESS)/
