@@ -243,14 +243,17 @@ pub fn plan(regions: &[Region], s: &Settings) -> Result<Plan, PlanError> {
     let mut uncleared = Vec::new();
     let spacing = s.sample.min(0.5);
     for (ri, m) in medial.iter().enumerate() {
-        for e in &m.edges {
-            let pts = densify(&e.points, spacing);
+        for chain in chains(&m.edges) {
+            let pts = densify(&chain, spacing);
             let flags: Vec<(bool, Option<usize>)> = pts
                 .iter()
                 .map(|p| {
                     let hot = grid.any_within(p, reach);
-                    let cap = point_clearance(p, &regions[ri]) - wall + camkit::tol::OFFSET_TOL;
-                    (hot, (0..LEVELS).find(|&k| radii[k] <= cap && pitches[k].is_some()))
+                    // A loop's centre keeps its radius plus a pitch (the chord between centres
+                    // cuts bends of the axis) from the walls.
+                    let cap = point_clearance(p, &regions[ri]) - wall;
+                    let fits = |k: usize| pitches[k].is_some_and(|pk| radii[k] + pk <= cap);
+                    (hot, (0..LEVELS).find(|&k| fits(k)))
                 })
                 .collect();
             danger.extend(stretches(&pts, &flags, |f| f.0));
@@ -294,6 +297,53 @@ pub fn plan(regions: &[Region], s: &Settings) -> Result<Plan, PlanError> {
         uncleared,
         danger_samples: hot.len(),
     })
+}
+
+/// The medial axis as polylines: edges joined end to end through vertices where exactly two
+/// edges meet, so that a trochoid run does not start over at every Voronoi vertex.
+fn chains(edges: &[medial::MedialEdge]) -> Vec<Vec<P2>> {
+    let key = |p: &P2| ((p.x * 1e6).round() as i64, (p.y * 1e6).round() as i64);
+    let mut at: HashMap<(i64, i64), Vec<usize>> = HashMap::new();
+    for (i, e) in edges.iter().enumerate() {
+        at.entry(key(&e.points[0])).or_default().push(i);
+        at.entry(key(&e.points[e.points.len() - 1])).or_default().push(i);
+    }
+    let mut used = vec![false; edges.len()];
+    let mut out = Vec::new();
+    // Start at chain ends (vertices of degree other than two) first, then close loops.
+    let mut order: Vec<usize> = (0..edges.len()).collect();
+    order.sort_by_key(|&i| {
+        let e = &edges[i];
+        let deg = |p: &P2| at.get(&key(p)).map_or(0, Vec::len);
+        u8::from(deg(&e.points[0]) == 2 && deg(&e.points[e.points.len() - 1]) == 2)
+    });
+    for start in order {
+        if used[start] {
+            continue;
+        }
+        used[start] = true;
+        let mut line = edges[start].points.clone();
+        let deg = |p: &P2| at.get(&key(p)).map_or(0, Vec::len);
+        if deg(&line[0]) == 2 && deg(&line[line.len() - 1]) != 2 {
+            // Walk from the free end.
+            line.reverse();
+        }
+        loop {
+            let end = key(&line[line.len() - 1]);
+            let Some(next) = at.get(&end).filter(|v| v.len() == 2).and_then(|v| v.iter().copied().find(|&j| !used[j]))
+            else {
+                break;
+            };
+            used[next] = true;
+            let mut pts = edges[next].points.clone();
+            if key(&pts[0]) != end {
+                pts.reverse();
+            }
+            line.extend(pts.into_iter().skip(1));
+        }
+        out.push(line);
+    }
+    out
 }
 
 /// The polyline with points added so that none are more than `h` apart.
