@@ -107,11 +107,17 @@ pub fn mesh_envelope(cond: &Conditions, grid: &Grid, dtheta: f64, dradial: f64, 
     HeightMap { grid: *grid, h }
 }
 
+/// Triangles whose plan area (twice, mm²) is below this are edge-on and skipped: their
+/// neighbours cover the same nodes.
+const DEGENERATE_AREA: f64 = 1e-18;
+/// Barycentric slack so nodes on a shared triangle edge are covered by both.
+const INSIDE_SLACK: f64 = 1e-12;
+
 /// Lowers the nodes under triangle `t` to its linearly interpolated height.
 fn raster(grid: &Grid, h: &mut [f64], t: [P3; 3]) {
     let [p, q, r] = t;
     let det = (q.x - p.x) * (r.y - p.y) - (r.x - p.x) * (q.y - p.y);
-    if det.abs() < 1e-18 {
+    if det.abs() < DEGENERATE_AREA {
         return;
     }
     let lo = |v: f64, o: f64| ((v - o) / grid.step).ceil().max(0.0) as usize;
@@ -123,7 +129,7 @@ fn raster(grid: &Grid, h: &mut [f64], t: [P3; 3]) {
             let (x, y) = (grid.x(i) - p.x, grid.y(j) - p.y);
             let b = (x * (r.y - p.y) - (r.x - p.x) * y) / det;
             let c = ((q.x - p.x) * y - x * (q.y - p.y)) / det;
-            if b >= -1e-12 && c >= -1e-12 && b + c <= 1.0 + 1e-12 {
+            if b >= -INSIDE_SLACK && c >= -INSIDE_SLACK && b + c <= 1.0 + INSIDE_SLACK {
                 let z = p.z + b * (q.z - p.z) + c * (r.z - p.z);
                 let slot = &mut h[i * grid.ny + j];
                 *slot = slot.min(z);

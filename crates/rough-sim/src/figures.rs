@@ -5,6 +5,9 @@
 
 use crate::patch::HeightMap;
 
+/// Nodes closer than this (mm) to a pass's centre line belong to neither side of it.
+const ON_PASS: f64 = 1e-12;
+
 /// The classic cusp height between passes, f²/8r (mm).
 pub fn cusp_classic(radius: f64, pick: f64) -> f64 {
     pick * pick / (8.0 * radius)
@@ -120,7 +123,7 @@ pub fn figures(map: &HeightMap, pick: f64, down_cut_left: bool) -> Figures {
                 hi2 = hi2.max(h);
                 lo2 = lo2.min(h);
             }
-            if offset.abs() > 1e-12 {
+            if offset.abs() > ON_PASS {
                 if down {
                     f.down_cut_max = f.down_cut_max.max(h);
                 } else {
@@ -133,7 +136,7 @@ pub fn figures(map: &HeightMap, pick: f64, down_cut_left: bool) -> Figures {
                 f.feed_rz = p.rz;
                 f.feed_rz_at = x;
             }
-            if offset.abs() > 1e-12 {
+            if offset.abs() > ON_PASS {
                 if down {
                     f.down_cut_feed_rz = f.down_cut_feed_rz.max(p.rz);
                 } else {

@@ -229,6 +229,9 @@ struct ZmapArgs {
     svg: Option<PathBuf>,
 }
 
+/// Resolution (mm) of the simulated flat radius of `flat-tip --simulate`.
+const FLAT_RESOLUTION: f64 = 1e-3;
+
 fn main() -> ExitCode {
     cli::run("rough-sim", || match Cli::parse().command {
         Command::Patch(a) => patch(a),
@@ -354,7 +357,7 @@ fn patch(a: PatchArgs) -> Result<()> {
         let dtheta = brute::angle_step(max_radial, cond.feed_per_radian(), spacing);
         let (worst, samples) = brute::worst_below(&cond, area, dtheta, spacing, max_radial);
         report.set("verify_samples", samples).set("verify_worst_below_um", um(worst));
-        if worst > 1e-4 {
+        if worst > rough_sim::STATED_ERROR {
             return Err(Error::check(format!(
                 "an edge point passes {:.4} µm below the computed surface (bound 0.1 µm)",
                 worst * 1e3
@@ -488,7 +491,7 @@ fn flat_tip(a: FlatArgs) -> Result<()> {
         let (_, f_with) = study::cell(&with, step);
         rows.push(("max_height_plain_um", f_plain.map.max_height * 1e3));
         rows.push(("max_height_with_r0_um", f_with.map.max_height * 1e3));
-        let sim = flat::simulated_r0(&plain, step, 1e-4, 1e-3).unwrap_or(f64::NAN);
+        let sim = flat::simulated_r0(&plain, step, rough_sim::STATED_ERROR, FLAT_RESOLUTION).unwrap_or(f64::NAN);
         rows.push(("r0_simulated_mm", sim));
         rows.push(("delta_simulated_um", (cond.cutter.radius - (cond.cutter.radius.powi(2) - sim * sim).sqrt()) * 1e3));
     }
