@@ -248,6 +248,52 @@ fn concave_remainder_touches_free_form_and_sphere_within_a_tenth_of_a_micron() {
     assert!(svg.starts_with("<svg") || svg.starts_with("<?xml"), "an SVG");
 }
 
+#[test]
+fn bezier_paraboloid_scan_keeps_r_by_grid_search() {
+    // z = (x² + y²)/40 over [−20, 20]² exactly, as a biquadratic Bézier patch: x and y are
+    // linear in u and v, z = a_i + a_j with a = (10, −10, 10).
+    let a = [10.0, -10.0, 10.0];
+    let net: Vec<String> = (0..3)
+        .map(|i| {
+            let row: Vec<String> =
+                (0..3).map(|j| format!("[{}, {}, {}]", 20 * i as i64 - 20, 20 * j as i64 - 20, a[i] + a[j])).collect();
+            format!("[{}]", row.join(", "))
+        })
+        .collect();
+    let w = Work::new();
+    let (cl, rep) = trace(
+        &w,
+        &format!(r#"{{"surfaces": [{{"type": "bezier", "control_points": [{}]}}]}}"#, net.join(", ")),
+        &["-r", "4", "--region", "-15,15,-15,15", "--pick", "5", "--angle", "20", "--zigzag"],
+    );
+    assert!(cl.len() > 50 && rep["paths"].as_u64().unwrap() >= 6);
+    // Independent distance: nested grid search over (x, y) on the explicit surface.
+    let dist = |q: &P3| {
+        let f = |x: f64, y: f64| (q - P3::new(x, y, (x * x + y * y) / 40.0)).norm();
+        let (mut bx, mut by, mut best) = (0.0, 0.0, f64::INFINITY);
+        let mut span = 20.0;
+        for _ in 0..9 {
+            let (cx, cy) = (bx, by);
+            for i in -10..=10 {
+                for j in -10..=10 {
+                    let (x, y) = (
+                        (cx + span * i as f64 / 10.0).clamp(-20.0, 20.0),
+                        (cy + span * j as f64 / 10.0).clamp(-20.0, 20.0),
+                    );
+                    let d = f(x, y);
+                    if d < best {
+                        (bx, by, best) = (x, y, d);
+                    }
+                }
+            }
+            span /= 8.0;
+        }
+        best
+    };
+    let worst = cl.iter().map(|q| (dist(&q.c) - 4.0).abs()).fold(0.0, f64::max);
+    assert!(worst <= CONTACT, "a CL point is {worst} mm off r from the paraboloid");
+}
+
 /// Distance from `q` to triangle abc, by projection and edges (independent of camkit's).
 fn triangle_distance(q: &P3, a: &P3, b: &P3, c: &P3) -> f64 {
     let n = (b - a).cross(&(c - a)).normalize();
@@ -390,6 +436,12 @@ fn bad_input_gets_one_clear_line_and_no_output() {
         &["-r", "1"],
     )
     .fails(2, "(surfaces[0].axis): axis must be a non-zero direction");
+    run(
+        r#"{"surfaces": [{"type": "bspline", "degree": [1, 1], "weights": [[1, 1], [-1, 1]],
+            "control_points": [[[0,0,0],[0,1,0]],[[1,0,0],[1,1,0]]]}]}"#,
+        &["-r", "1"],
+    )
+    .fails(2, "(surfaces[0].weights[1][0]): a weight must be a positive number, got -1");
     run(sphere, &["-r", "0"]).fails(2, "--radius must be a positive number");
     run(sphere, &["-r", "-2"]).fails(2, "--radius must be a positive number");
     run(sphere, &["-r", "1", "--region", "100,200,100,200"]).fails(2, "misses the model");
