@@ -10,6 +10,7 @@ use camkit::model::Model;
 use proptest::prelude::*;
 use stylus_trace::curve::{Steps, Stylus};
 use stylus_trace::scan::Scan;
+use stylus_trace::two_surface::TwoSurface;
 use stylus_trace::{Mode, Options, Region, TracedPath, trace};
 
 const CONTACT: f64 = 1e-4;
@@ -176,5 +177,47 @@ proptest! {
             prop_assert!(p.points.iter().all(|q| (q.centre.z - p.points[0].centre.z).abs() < 1e-12), "a level stays level");
             prop_assert_eq!(p.points[0].centre, p.points[p.points.len() - 1].centre);
         }
+    }
+
+    /// Two-surface contact on a ball resting on a tilted plane: the Newton correction in XY and Z
+    /// converges onto the circle where the stylus is r from the plane and R + r from the ball's
+    /// centre (radius 2·sqrt(R·r) about the ball's foot), and the line closes.
+    #[test]
+    fn two_surface_converges_on_a_ball_resting_on_a_tilted_plane(
+        theta in 0.0..std::f64::consts::TAU, phi in 0.0..0.5f64, big in 5.0..30.0f64, r in 0.5..4.0f64,
+    ) {
+        let n = unit(theta, phi);
+        let s = P3::from(n * big);
+        let m = model(&format!(
+            r#"{{"surfaces": [{{"type": "plane", "point": [0, 0, 0], "normal": [{}, {}, {}]}},
+                             {{"type": "sphere", "centre": [{}, {}, {}], "radius": {big}}}]}}"#,
+            n.x, n.y, n.z, s.x, s.y, s.z
+        ));
+        let e = n.cross(&V3::z()).try_normalize(1e-9).unwrap_or(V3::x());
+        let rho = 2.0 * (big * r).sqrt();
+        let start = P3::from(n * r) + e * rho;
+        let reach = big + rho + 10.0;
+        let ts = TwoSurface {
+            surfaces: [0, 1],
+            start: Some(start),
+            reverse: false,
+            region: Region { x0: -reach, x1: reach, y0: -reach, y1: reach },
+        };
+        let paths = trace(&m, &options(r, Mode::TwoSurface(ts)), &|| ()).unwrap();
+        prop_assert_eq!(paths.len(), 1);
+        let pts = &paths[0].points;
+        prop_assert!(pts.len() > 8);
+        prop_assert_eq!(pts[0].centre, pts[pts.len() - 1].centre, "the line closes");
+        for q in pts {
+            prop_assert!((q.centre.coords.dot(&n) - r).abs() <= CONTACT, "plane: {}", q.centre.coords.dot(&n) - r);
+            prop_assert!(((q.centre - s).norm() - (big + r)).abs() <= CONTACT, "ball: {}", (q.centre - s).norm() - (big + r));
+            prop_assert!(q.second.is_some());
+        }
+        // Chords of the circle (in its plane, radius rho about the ball's foot) within 1 µm.
+        let (_, chords) = off(&paths, |q| {
+            let v = q - P3::from(n * r);
+            (v - n * v.dot(&n)).norm() - rho
+        });
+        prop_assert!(chords <= CHORD, "chord off by {}", chords);
     }
 }
