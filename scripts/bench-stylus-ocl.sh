@@ -3,7 +3,8 @@
 # CL points per second for each, and the largest distance from our ball centres to OpenCAMLib's
 # densely sampled CL curve on the same scan lines (both are exact on the mesh: they must agree to
 # 1 µm). Installs opencamlib, numpy and numpy-stl into a virtualenv under $WORK and makes its own
-# STL files: a 100 × 100 mm free-form height field of ≈20 k and ≈200 k triangles.
+# STL files: a 100 × 100 mm free-form height field of ≈20 k and ≈200 k triangles; last, the load
+# time of the same field at ≈1 M triangles.
 #
 #   scripts/bench-stylus-ocl.sh            # both meshes
 #   MESHES=20000 scripts/bench-stylus-ocl.sh
@@ -23,9 +24,9 @@ cargo build -q --release -p stylus-trace
 BIN=${CARGO_TARGET_DIR:-target}/release/stylus-trace
 PY="$WORK/venv/bin/python"
 
-for TRIS in $MESHES; do
-  STL="$WORK/freeform-$TRIS.stl"
-  "$PY" - "$STL" "$TRIS" <<'EOF'
+# make_stl FILE TRIANGLES: the free-form height field as binary STL.
+make_stl() {
+  [ -f "$1" ] || "$PY" - "$1" "$2" <<'EOF'
 import sys, math
 import numpy as np
 from stl import mesh
@@ -42,6 +43,11 @@ m.vectors[:] = t
 m.save(path)
 print(f"{path}: {len(t)} triangles")
 EOF
+}
+
+for TRIS in $MESHES; do
+  STL="$WORK/freeform-$TRIS.stl"
+  make_stl "$STL" "$TRIS"
 
   # stylus-trace: the whole raster, lines y = 0.5 .. 99.5 every PICK, x 0 .. 100.
   "$BIN" "$STL" -r $R --pick $PICK --region 0,100,0.5,99.5 --max-step $STEP \
@@ -106,3 +112,9 @@ print(f"  agreement    : largest distance from our centres to OpenCAMLib's dense
       f"(y 30.5, 70.5; x 40.5..59.5) = {worst * 1000:.4f} µm")
 EOF
 done
+
+# Loading: a 1 M-triangle STL (read, checked, indexed), traced over a 1 mm² patch only.
+STL="$WORK/freeform-1000000.stl"
+make_stl "$STL" 1000000
+"$BIN" "$STL" -r $R --region 40,41,50,51 -o "$WORK/load.csv" --report "$WORK/load.json"
+"$PY" -c "import json; r = json.load(open('$WORK/load.json')); print(f\"load: {r['triangles']} triangles in {r['load_seconds']:.2f} s\")"
