@@ -43,6 +43,17 @@ pub struct Tool {
     /// Tool number for the tool change (T word).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub number: Option<u32>,
+    /// Included angle of a flat-type non-rotating tool's edge between its two flanks (degrees);
+    /// paper 000 grinds it 5° below the model's corner angle to keep the second flank clear.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub included_angle: Option<f64>,
+    /// Length of a flat-type tool's flank from the tip P2 to the control point P1 or P3 (mm).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub flank_length: Option<f64>,
+    /// Range of tool tilt the tool cuts stably in, [min, max] degrees (paper 000: [−20, 0] for
+    /// the cylindrical non-rotating tool); gouge avoidance keeps the tilt inside it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tilt_range: Option<[f64; 2]>,
 }
 
 impl Tool {
@@ -70,6 +81,21 @@ impl Tool {
         }
         if self.length.is_some_and(|l| !positive(l)) {
             return Err(field_error(file, "length", "length must be positive"));
+        }
+        if self.included_angle.is_some_and(|a| !(a > 0.0 && a < 180.0)) {
+            return Err(field_error(file, "included_angle", "included_angle must be between 0 and 180 degrees"));
+        }
+        if self.flank_length.is_some_and(|l| !positive(l)) {
+            return Err(field_error(file, "flank_length", "flank_length must be a positive number of mm"));
+        }
+        if let Some([lo, hi]) = self.tilt_range {
+            if !(lo > -90.0 && lo <= hi && hi < 90.0) {
+                return Err(field_error(
+                    file,
+                    "tilt_range",
+                    "tilt_range must be [min, max] degrees with -90 < min <= max < 90",
+                ));
+            }
         }
         Ok(())
     }
@@ -105,5 +131,11 @@ mod tests {
         assert!(e.to_string().starts_with("t.json:1:16 (kind): unknown variant `drill`"), "{e}");
         let e = parse(r#"{"kind": "bull", "radius": 5}"#).unwrap_err();
         assert!(e.to_string().contains("(corner_radius)"), "{e}");
+        let t = parse(r#"{"kind": "flat-nonrotating", "radius": 5, "included_angle": 85, "flank_length": 3}"#).unwrap();
+        assert_eq!((t.included_angle, t.flank_length), (Some(85.0), Some(3.0)));
+        let e = parse(r#"{"kind": "flat-nonrotating", "radius": 5, "included_angle": 190}"#).unwrap_err();
+        assert!(e.to_string().contains("(included_angle)"), "{e}");
+        let e = parse(r#"{"kind": "cylindrical-nonrotating", "radius": 12.5, "tilt_range": [0, -20]}"#).unwrap_err();
+        assert!(e.to_string().contains("(tilt_range)"), "{e}");
     }
 }

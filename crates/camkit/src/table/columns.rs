@@ -105,6 +105,12 @@ pub const COLUMNS: &[ColumnSpec] = &[
     named!("bx", "unit vector", "empty", "bisector of both contact normals (basic tool axis, paper 000 fig. 10), x"),
     named!("by", "unit vector", "empty", "bisector, y"),
     named!("bz", "unit vector", "empty", "bisector, z"),
+    named!("tilt", "deg", "empty", "tool-attitude: tilt used (θ cylinder, ζ ball, flat-type axis correction)"),
+    named!("r_edge", "mm", "empty", "tool-attitude: R' of paper 000 eq. 1 (cylindrical tool; empty: infinite)"),
+    named!("flank_gap", "deg", "empty", "tool-attitude: stand-off of the flat-type tool's second flank"),
+    named!("gouge", "mm", "empty", "tool-attitude --model: deepest penetration of the tool body into the model"),
+    named!("ac_a", "deg", "empty", "tool-attitude: A angle of paper 002 eq. 3 (A/C table machine)"),
+    named!("ac_c", "deg", "empty", "tool-attitude: C angle of paper 002 eq. 4"),
 ];
 
 /// The spec of a typed column.

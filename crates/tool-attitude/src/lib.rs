@@ -1,0 +1,209 @@
+//! `tool-attitude`: tool tip, tool axis and spindle orientation from contact data (the stream
+//! `stylus-trace` writes), for the cylindrical non-rotating tool tilted toward the feed (paper 000
+//! §2, §3.2(1), eq. 1), the flat-type non-rotating tool (000 §3.2(2)), the ball end mill with a
+//! tilt (003 §3.1) and the flat end mill along the normal (002 §4.2), with gouge checks of the
+//! whole tool body against the model.
+//!
+//! [`pose`] holds the closed-form poses, [`edge`] eq. (1), [`flat_type`] the control-stylus
+//! correction, [`gouge`] the body probes and the tilt search; [`attitude`] puts them together
+//! for one row.
+
+pub mod edge;
+pub mod flat_type;
+pub mod gouge;
+pub mod pose;
+
+use camkit::geom::{P3, V3};
+use camkit::model::Model;
+use pose::Pose;
+
+/// The tool, as `tool-attitude` uses it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Shape {
+    /// Cylindrical non-rotating tool of `radius`; `cut_depth` is T of eq. (1) (0: the limit).
+    Cylinder {
+        /// R (mm).
+        radius: f64,
+        /// T (mm).
+        cut_depth: f64,
+    },
+    /// Flat-type non-rotating tool.
+    FlatType {
+        /// Edge geometry.
+        edge: flat_type::Edge,
+        /// True: the control stylus is P3 on the second surface; false: P1 on the first.
+        control_second: bool,
+    },
+    /// Ball end mill of `radius`; `side` tilts across the feed (paper 003) instead of along it.
+    Ball {
+        /// r (mm).
+        radius: f64,
+        /// Tilt across the feed.
+        side: bool,
+    },
+    /// Flat end mill of `radius` along the normal.
+    FlatMill {
+        /// R (mm).
+        radius: f64,
+    },
+}
+
+/// Settings for every row.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Setup {
+    /// The tool.
+    pub shape: Shape,
+    /// Requested tilt (radians): θ of the cylinder, ζ of the ball; unused otherwise.
+    pub tilt: f64,
+    /// Allowed tilt range (radians) for gouge avoidance.
+    pub range: (f64, f64),
+    /// Length of the tool body above the tip that the gouge check probes (mm).
+    pub length: f64,
+    /// Penetration tolerated before a pose counts as gouging (mm).
+    pub gouge_tol: f64,
+}
+
+/// One row's contact data.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Contact {
+    /// Stylus centre (x, y, z of the stream).
+    pub centre: P3,
+    /// Contact point.
+    pub point: P3,
+    /// Unit normal at the contact.
+    pub normal: V3,
+    /// Second contact (two-surface stream): point and unit normal.
+    pub second: Option<(P3, V3)>,
+    /// Model surface indices of both contacts, when known (flat-type correction).
+    pub surfaces: (Option<usize>, Option<usize>),
+    /// Feed direction (unit).
+    pub feed: V3,
+}
+
+/// One row's result.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Attitude {
+    /// The pose.
+    pub pose: Pose,
+    /// Tilt used (radians): θ, ζ, or the flat-type correction from the bisector.
+    pub tilt: f64,
+    /// R' of eq. (1) (cylinder; `None` where infinite or undefined).
+    pub edge_radius: Option<f64>,
+    /// Machine angles [a, c] of eq. (3)–(4), degrees (flat end mill).
+    pub machine: Option<(f64, f64)>,
+    /// Second-flank stand-off (radians, flat-type tool).
+    pub flank_gap: Option<f64>,
+    /// Penetration into the model at the pose (mm), with a model.
+    pub gouge: Option<f64>,
+    /// True when the tilt was changed to avoid a gouge.
+    pub adjusted: bool,
+}
+
+/// Why a row has no attitude.
+#[derive(Clone, Debug, PartialEq)]
+pub enum RowError {
+    /// The feed runs along the normal: no tilt direction.
+    FeedAlongNormal,
+    /// The flat-type tool needs the second contact (two-surface stream).
+    NoSecondContact,
+    /// The flat-type correction failed.
+    Flat(flat_type::FlatError),
+}
+
+impl std::fmt::Display for RowError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            RowError::FeedAlongNormal => f.write_str("the feed direction is along the normal: no tilt plane"),
+            RowError::NoSecondContact => {
+                f.write_str("the flat-type tool needs both contacts (stylus-trace --mode two-surface)")
+            }
+            RowError::Flat(flat_type::FlatError::NoCorner) => {
+                f.write_str("both normals are parallel: no concave corner")
+            }
+            RowError::Flat(flat_type::FlatError::NoContact) => {
+                f.write_str("the control stylus could not be brought onto its surface")
+            }
+        }
+    }
+}
+
+/// The attitude of one row; with a model, the tool body is checked and the tilt adjusted inside
+/// the range where the tool has a free tilt (cylinder, ball).
+pub fn attitude(setup: &Setup, c: &Contact, model: Option<&Model>) -> Result<Attitude, RowError> {
+    let n = c.normal;
+    let gouge_at =
+        |pose: &Pose, probes: &dyn Fn(&Pose) -> Vec<gouge::Probe>| model.map(|m| gouge::penetration(m, &probes(pose)));
+    match setup.shape {
+        Shape::Cylinder { radius, cut_depth } => {
+            let f = pose::tangent_feed(&n, &c.feed).ok_or(RowError::FeedAlongNormal)?;
+            let make = |t: f64| pose::cylinder(&c.point, &n, &f, radius, t);
+            let probes = |p: &Pose| gouge::cylinder_probes(&p.tip, &p.axis, p.edge.as_ref(), radius, setup.length);
+            let (tilt, gouge, adjusted) = tilt_search(setup, model, &|t| make(t), &probes);
+            Ok(Attitude {
+                pose: make(tilt),
+                tilt,
+                edge_radius: edge::edge_radius(radius, cut_depth, tilt),
+                machine: None,
+                flank_gap: None,
+                gouge,
+                adjusted,
+            })
+        }
+        Shape::Ball { radius, side } => {
+            let f = pose::tangent_feed(&n, &c.feed).ok_or(RowError::FeedAlongNormal)?;
+            let dir = if side { f.cross(&n) } else { f };
+            let make = |t: f64| pose::ball(&c.point, &n, &dir, radius, t);
+            let probes = |p: &Pose| gouge::ball_probes(&p.tip, &p.axis, radius, setup.length);
+            let (tilt, gouge, adjusted) = tilt_search(setup, model, &|t| make(t), &probes);
+            Ok(Attitude { pose: make(tilt), tilt, edge_radius: None, machine: None, flank_gap: None, gouge, adjusted })
+        }
+        Shape::FlatMill { radius } => {
+            let pose = pose::flat_mill(&c.point, &n);
+            let gouge = gouge_at(&pose, &|p| gouge::cylinder_probes(&p.tip, &p.axis, None, radius, setup.length));
+            Ok(Attitude {
+                pose,
+                tilt: 0.0,
+                edge_radius: None,
+                machine: Some(pose::machine_angles(&pose.axis)),
+                flank_gap: None,
+                gouge,
+                adjusted: false,
+            })
+        }
+        Shape::FlatType { edge, control_second } => {
+            let (p2, n2) = c.second.ok_or(RowError::NoSecondContact)?;
+            let (control, other, index) =
+                if control_second { ((p2, n2), n, c.surfaces.1) } else { ((c.point, n), n2, c.surfaces.0) };
+            let corner = flat_type::Corner { centre: c.centre, control, other };
+            let dist = model.zip(index).map(|(m, i)| move |q: &P3| m.nearest_on(q, i).distance);
+            let dist_ref = dist.as_ref().map(|d| d as &dyn Fn(&P3) -> f64);
+            let fp = flat_type::solve(&corner, &edge, &c.feed, dist_ref).map_err(RowError::Flat)?;
+            let r = (c.centre - control.0).norm();
+            let gouge = model.map(|m| {
+                gouge::penetration(m, &gouge::flank_probes(&fp.pose.tip, flat_type::flanks(&fp, &edge), edge.flank, r))
+            });
+            Ok(Attitude {
+                pose: fp.pose,
+                tilt: fp.correction,
+                edge_radius: None,
+                machine: None,
+                flank_gap: Some(fp.flank_gap),
+                gouge,
+                adjusted: false,
+            })
+        }
+    }
+}
+
+/// The requested tilt, or with a model the clear tilt nearest it inside the range.
+fn tilt_search(
+    setup: &Setup,
+    model: Option<&Model>,
+    make: &dyn Fn(f64) -> Pose,
+    probes: &dyn Fn(&Pose) -> Vec<gouge::Probe>,
+) -> (f64, Option<f64>, bool) {
+    let Some(m) = model else { return (setup.tilt, None, false) };
+    let g = |t: f64| gouge::penetration(m, &probes(&make(t)));
+    let a = gouge::adjust(setup.tilt, setup.range.0, setup.range.1, setup.gouge_tol, g);
+    (a.tilt, Some(a.gouge), a.tilt != setup.tilt)
+}

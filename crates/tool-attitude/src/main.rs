@@ -1,0 +1,445 @@
+//! `tool-attitude`: the clap CLI round the library: reads the contact stream, the tool and the
+//! model, solves every row in parallel, checks the poses, writes the toolpath table.
+
+use camkit::cli::{self, IoArgs};
+use camkit::doc::{Tool, ToolKind};
+use camkit::error::{Error, Location, Result};
+use camkit::geom::{P3, V3};
+use camkit::io::{Input, Output};
+use camkit::json::field_error;
+use camkit::model::Model;
+use camkit::report::Report;
+use camkit::table::{self, Col, Field, Table, WriteOptions};
+use clap::{Parser, ValueEnum};
+use rayon::prelude::*;
+use std::process::ExitCode;
+use std::time::Instant;
+use tool_attitude::flat_type::Edge;
+use tool_attitude::{Attitude, Contact, RowError, Setup, Shape, attitude, edge, pose};
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+enum TiltPlane {
+    /// Toward the feed (lead angle).
+    Feed,
+    /// Across the feed, to its right seen from above the surface (paper 003's ζ).
+    Side,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+enum ControlPoint {
+    /// P1 on the first surface (`px..`, `nx..`).
+    P1,
+    /// P3 on the second surface (`p2x..`, `n2x..`).
+    P3,
+}
+
+#[derive(Parser, Debug)]
+#[command(
+    name = "tool-attitude",
+    version,
+    allow_negative_numbers = true,
+    about = "Tool tip, tool axis and spindle orientation from contact data (the stream stylus-trace writes).",
+    long_about = "Tool tip, tool axis and spindle orientation from contact data (the stream stylus-trace \
+writes: contact point, unit normal, stylus centre; the feed is the direction between consecutive rows of a \
+path). Tools (--tool JSON, `kind`): cylindrical-nonrotating (paper 000 §3.2(1): axis = normal tilted by θ \
+toward the feed in the plane of normal and feed, tip = bottom-face centre R behind the cutting point, edge \
+facing the feed; R' of eq. 1 per row), flat-nonrotating (000 §3.2(2): tip P2 at the two-surface stylus \
+centre, axis from the bisector of both normals corrected until the control stylus at P1/P3 touches its \
+surface), ball (003 §3.1: tilt ζ; tip = ball centre − r·axis), flat (002 §4.2: axis = normal, machine \
+angles [a, c] of eq. 3–4). With --model every pose's tool body is tested against the model; where the tilted \
+tool cuts in, the tilt is moved inside the tool's range to the nearest clear one, and rows that stay \
+gouging fail the run (exit 1) unless --allow-gouge.",
+    after_help = after_help()
+)]
+struct Args {
+    #[command(flatten)]
+    io: IoArgs,
+    /// The tool document (JSON: kind, radius, ...).
+    #[arg(short = 't', long, value_name = "FILE")]
+    tool: String,
+    /// Tilt (degrees): θ of the cylindrical tool (paper's sign: negative leans toward the feed;
+    /// default −5), ζ of the ball end mill (default 0).
+    #[arg(long, value_name = "DEG", conflicts_with = "edge_radius")]
+    tilt: Option<f64>,
+    /// Choose θ of the cylindrical tool so that eq. 1 gives this R' (mm).
+    #[arg(long, value_name = "MM")]
+    edge_radius: Option<f64>,
+    /// Depth of cut T of eq. 1 (mm); 0 takes the limit T → 0, R' = R / sin|θ|.
+    #[arg(long, default_value_t = 0.0, value_name = "MM")]
+    cut_depth: f64,
+    /// Plane of the ball end mill's tilt.
+    #[arg(long, value_enum, default_value_t = TiltPlane::Side)]
+    tilt_plane: TiltPlane,
+    /// Control stylus of the flat-type tool.
+    #[arg(long, value_enum, default_value_t = ControlPoint::P1)]
+    control: ControlPoint,
+    /// The model (JSON document or STL) for gouge checks and the flat-type correction.
+    #[arg(long, value_name = "FILE")]
+    model: Option<String>,
+    /// Penetration (mm) of the tool body into the model tolerated before a pose gouges.
+    #[arg(long, default_value_t = 0.001, value_name = "MM")]
+    gouge_tol: f64,
+    /// Write the table even when rows gouge (they are reported; exit 0).
+    #[arg(long)]
+    allow_gouge: bool,
+    /// Decimals of written positions (default: shortest exact text).
+    #[arg(long, value_name = "N")]
+    decimals: Option<u32>,
+}
+
+fn after_help() -> String {
+    let mut s = table::columns::help_text(
+        &[Col::Path, Col::X, Col::Y, Col::Z, Col::Px, Col::Py, Col::Pz, Col::Nx, Col::Ny, Col::Nz],
+        &[Col::X, Col::Y, Col::Z, Col::I, Col::J, Col::K, Col::S],
+    );
+    s.push_str("  two-surface streams also: p2x p2y p2z n2x n2y n2z (second contact), surface, surface2\n");
+    s.push_str("  written by name: tilt (deg), r_edge (mm, cylinder), ac_a ac_c (deg, flat end mill),\n");
+    s.push_str("  flank_gap (deg, flat-type), gouge (mm, with --model)\n");
+    s.push_str("Other columns pass through.\n\nExit status: 0 done, 1 a check failed (gouge), 2 bad input or usage.");
+    s
+}
+
+fn main() -> ExitCode {
+    cli::run("tool-attitude", || run(Args::parse()))
+}
+
+/// The stable tilt range of paper 000 for the cylindrical tool, and paper 003's studied tilts.
+const CYLINDER_RANGE: [f64; 2] = [-20.0, 0.0];
+const BALL_RANGE: [f64; 2] = [0.0, 15.0];
+
+fn setup(args: &Args, tool: &Tool, tool_file: &str) -> Result<Setup> {
+    let usage = |m: String| Error::input(m);
+    if !(args.gouge_tol.is_finite() && args.gouge_tol >= 0.0) {
+        return Err(usage(format!("--gouge-tol must be a number ≥ 0, got {}", args.gouge_tol)));
+    }
+    if !(args.cut_depth.is_finite() && args.cut_depth >= 0.0) {
+        return Err(usage(format!("--cut-depth must be a number ≥ 0, got {}", args.cut_depth)));
+    }
+    if args.decimals.is_some_and(|d| d > 12) {
+        return Err(usage("--decimals must be at most 12".into()));
+    }
+    let r = tool.radius;
+    let (shape, default_tilt, default_range) = match tool.kind {
+        ToolKind::CylindricalNonrotating => {
+            (Shape::Cylinder { radius: r, cut_depth: args.cut_depth }, -5.0, CYLINDER_RANGE)
+        }
+        ToolKind::Ball => (Shape::Ball { radius: r, side: args.tilt_plane == TiltPlane::Side }, 0.0, BALL_RANGE),
+        ToolKind::Flat => (Shape::FlatMill { radius: r }, 0.0, [0.0, 0.0]),
+        ToolKind::FlatNonrotating => {
+            let missing = |f: &str| field_error(tool_file, f, format!("a flat-nonrotating tool needs `{f}`"));
+            let included = tool.included_angle.ok_or_else(|| missing("included_angle"))?;
+            let flank = tool.flank_length.ok_or_else(|| missing("flank_length"))?;
+            let edge = Edge { included: included.to_radians(), flank };
+            (Shape::FlatType { edge, control_second: args.control == ControlPoint::P3 }, 0.0, [0.0, 0.0])
+        }
+        ToolKind::Bull => {
+            return Err(field_error(
+                tool_file,
+                "kind",
+                "tool-attitude takes ball, flat, cylindrical-nonrotating or flat-nonrotating tools, not bull",
+            ));
+        }
+    };
+    let range = tool.tilt_range.unwrap_or(default_range);
+    let free = matches!(shape, Shape::Cylinder { .. } | Shape::Ball { .. });
+    let mut tilt = args.tilt.unwrap_or(default_tilt);
+    if let Some(re) = args.edge_radius {
+        let Shape::Cylinder { radius, cut_depth } = shape else {
+            return Err(usage("--edge-radius applies to the cylindrical-nonrotating tool".into()));
+        };
+        let theta = edge::tilt_for_edge_radius(radius, cut_depth, re).ok_or_else(|| {
+            usage(format!(
+                "--edge-radius {re}: eq. 1 gives R' from R = {radius} up to {} mm for this tool and --cut-depth",
+                edge::largest_edge_radius(radius, cut_depth)
+            ))
+        })?;
+        tilt = theta.to_degrees();
+    }
+    if !free && args.tilt.is_some() {
+        return Err(usage("--tilt applies to the cylindrical-nonrotating and ball tools".into()));
+    }
+    if free && !(tilt >= range[0] - 1e-9 && tilt <= range[1] + 1e-9) {
+        let source = args.edge_radius.map(|re| format!("--edge-radius {re} needs ")).unwrap_or_default();
+        return Err(usage(format!(
+            "{source}tilt {tilt}° is outside the tool's range [{}, {}]° (tool `tilt_range`, paper 000: −20..0 for the cylindrical tool)",
+            range[0], range[1]
+        )));
+    }
+    Ok(Setup {
+        shape,
+        tilt: tilt.to_radians(),
+        range: (range[0].to_radians(), range[1].to_radians()),
+        length: tool.length.unwrap_or(4.0 * r),
+        gouge_tol: args.gouge_tol,
+    })
+}
+
+/// Column number (1-based) and name of a column in the table, for error locations.
+fn column_of(t: &Table, name: &str) -> u64 {
+    t.schema
+        .fields
+        .iter()
+        .position(|f| match f {
+            Field::Known(c) => table::columns::spec(*c).name == name,
+            Field::Extra(i) => t.schema.extra_names[*i] == name,
+        })
+        .map_or(0, |p| p as u64 + 1)
+}
+
+/// Reads the unit normal of a row from typed or named columns; refuses zero or non-unit ones.
+fn unit_normal(v: V3, t: &Table, file: &str, line: u64, col: &str) -> Result<V3> {
+    let len = v.norm();
+    if (len - 1.0).abs() > camkit::tol::UNIT_VECTOR_SLACK {
+        return Err(Error::input(format!(
+            "the normal ({}, {}, {}) is not a unit vector (length {len})",
+            v.x, v.y, v.z
+        ))
+        .at(Location::file(file).line(line).column(column_of(t, col)).field(col)));
+    }
+    Ok(v / len)
+}
+
+/// Contacts of every row (feed still zero) and the rows' pass starts.
+fn contacts(t: &Table, file: &str, model: Option<&Model>, needs_second: bool) -> Result<Vec<Contact>> {
+    let names = ["p2x", "p2y", "p2z", "n2x", "n2y", "n2z"];
+    let idx: Vec<Option<usize>> = names.iter().map(|n| t.schema.extra_index(n)).collect();
+    if needs_second {
+        if let Some(k) = idx.iter().position(Option::is_none) {
+            return Err(Error::input(format!(
+                "missing column `{}`: the flat-type tool needs the two-surface stream (stylus-trace --mode two-surface)",
+                names[k]
+            ))
+            .at(Location::file(file).line(1)));
+        }
+    }
+    let (s1, s2) = (t.schema.extra_index("surface"), t.schema.extra_index("surface2"));
+    let mut out = Vec::with_capacity(t.rows.len());
+    for row in &t.rows {
+        let (Some(point), Some(n)) = (row.contact, row.normal) else {
+            let col = if row.contact.is_none() { "px" } else { "nx" };
+            return Err(Error::input("empty contact point or normal: every row needs px..pz and nx..nz")
+                .at(Location::file(file).line(row.line).column(column_of(t, col)).field(col)));
+        };
+        let normal = unit_normal(n, t, file, row.line, "nx")?;
+        let second = if needs_second {
+            let mut v = [0.0; 6];
+            for (k, slot) in v.iter_mut().enumerate() {
+                let i = idx[k].expect("checked above");
+                let text = row.extra.get(i).map_or("", String::as_str);
+                *slot = camkit::num::parse_finite(text).map_err(|e| {
+                    Error::input(e.message(text))
+                        .at(Location::file(file).line(row.line).column(column_of(t, names[k])).field(names[k]))
+                })?;
+            }
+            let n2 = unit_normal(V3::new(v[3], v[4], v[5]), t, file, row.line, "n2x")?;
+            Some((P3::new(v[0], v[1], v[2]), n2))
+        } else {
+            None
+        };
+        let surface =
+            |i: Option<usize>| model.zip(i).and_then(|(m, i)| row.extra.get(i).and_then(|name| m.surface_index(name)));
+        out.push(Contact {
+            centre: row.pos,
+            point,
+            normal,
+            second,
+            surfaces: (surface(s1), surface(s2)),
+            feed: V3::zeros(),
+        });
+    }
+    // Feed directions per pass from consecutive stylus centres.
+    let mut start = 0;
+    while start < t.rows.len() {
+        let path = t.rows[start].path;
+        let end = (start..t.rows.len()).find(|&i| t.rows[i].path != path).unwrap_or(t.rows.len());
+        let centres: Vec<P3> = out[start..end].iter().map(|c| c.centre).collect();
+        match pose::feed_directions(&centres) {
+            Ok(f) => f.into_iter().enumerate().for_each(|(k, d)| out[start + k].feed = d),
+            Err(k) => {
+                let line = t.rows[start + k].line;
+                let what = if end - start < 2 {
+                    format!("path {path} has {} row: the feed direction needs at least two", end - start)
+                } else {
+                    "this row repeats the previous position: no feed direction".into()
+                };
+                return Err(Error::input(what).at(Location::file(file).line(line)));
+            }
+        }
+        start = end;
+    }
+    Ok(out)
+}
+
+fn run(args: Args) -> Result<()> {
+    let started = Instant::now();
+    let tool_input = Input::open(&args.tool)?;
+    let tool: Tool = camkit::json::from_input(&tool_input)?;
+    tool.validate(&tool_input.name)?;
+    let setup = setup(&args, &tool, &tool_input.name)?;
+    let model = match &args.model {
+        Some(m) => Some(Model::load(&Input::open(m)?)?),
+        None => None,
+    };
+    let input = Input::open(&args.io.input)?;
+    let mut t = table::read(&input, &[Col::X, Col::Y, Col::Z, Col::Px, Col::Py, Col::Pz, Col::Nx, Col::Ny, Col::Nz])?;
+    if t.rows.is_empty() {
+        return Err(Error::input("no rows: the feed direction needs at least two rows of a path")
+            .at(Location::file(&input.name)));
+    }
+    let needs_second = matches!(setup.shape, Shape::FlatType { .. });
+    let cs = contacts(&t, &input.name, model.as_ref(), needs_second)?;
+    if needs_second && model.is_some() && cs.iter().any(|c| c.surfaces.0.is_none() || c.surfaces.1.is_none()) {
+        cli::warn("rows without `surface`/`surface2` names of the model: their flat-type axis uses the tangent planes");
+    }
+    let solved_at = Instant::now();
+    let results: Vec<std::result::Result<Attitude, RowError>> =
+        cs.par_iter().map(|c| attitude(&setup, c, model.as_ref())).collect();
+    let seconds_solve = solved_at.elapsed().as_secs_f64();
+    let mut poses = Vec::with_capacity(results.len());
+    for (k, r) in results.into_iter().enumerate() {
+        match r {
+            Ok(a) => poses.push(a),
+            Err(e) => {
+                let loc = Location::file(&input.name).line(t.rows[k].line);
+                return Err(match e {
+                    RowError::Flat(tool_attitude::flat_type::FlatError::NoContact) => {
+                        Error::check(e.to_string()).at(loc)
+                    }
+                    _ => Error::input(e.to_string()).at(loc),
+                });
+            }
+        }
+    }
+    let checks = self_check(&setup, &cs, &poses);
+    if checks.worst > POSE_CHECK {
+        return Err(Error::check(format!("a pose failed its own check by {:e} (a bug)", checks.worst)));
+    }
+    // Output table.
+    let nonrotating = matches!(setup.shape, Shape::Cylinder { .. } | Shape::FlatType { .. });
+    t.schema.add(&[Col::I, Col::J, Col::K]);
+    if nonrotating {
+        t.schema.add(&[Col::S]);
+    }
+    let c_tilt = t.add_extra_column("tilt");
+    let c_edge = matches!(setup.shape, Shape::Cylinder { .. }).then(|| t.add_extra_column("r_edge"));
+    let c_ac =
+        matches!(setup.shape, Shape::FlatMill { .. }).then(|| (t.add_extra_column("ac_a"), t.add_extra_column("ac_c")));
+    let c_gap = needs_second.then(|| t.add_extra_column("flank_gap"));
+    let c_gouge = model.is_some().then(|| t.add_extra_column("gouge"));
+    let num = |v: f64| {
+        let mut b = Vec::new();
+        camkit::num::push_shortest(&mut b, v);
+        String::from_utf8(b).expect("ascii")
+    };
+    let mut gouging = Vec::new();
+    for (k, (row, a)) in t.rows.iter_mut().zip(&poses).enumerate() {
+        row.pos = a.pose.tip;
+        row.axis = a.pose.axis;
+        row.s = if nonrotating { a.pose.spindle() } else { None };
+        row.extra[c_tilt] = num(a.tilt.to_degrees());
+        if let Some(i) = c_edge {
+            row.extra[i] = a.edge_radius.map(num).unwrap_or_default();
+        }
+        if let (Some((ia, ic)), Some((va, vc))) = (c_ac, a.machine) {
+            row.extra[ia] = num(va);
+            row.extra[ic] = num(vc);
+        }
+        if let (Some(i), Some(g)) = (c_gap, a.flank_gap) {
+            row.extra[i] = num(g.to_degrees());
+        }
+        if let (Some(i), Some(g)) = (c_gouge, a.gouge) {
+            row.extra[i] = num(g);
+            if g > setup.gouge_tol {
+                gouging.push(k);
+            }
+        }
+    }
+    let mut report = Report::new("tool-attitude");
+    report
+        .set("tool", &tool)
+        .set("rows", t.rows.len())
+        .set("paths", t.passes().count())
+        .set("tilt_deg", setup.tilt.to_degrees())
+        .set("tilt_range_deg", [setup.range.0.to_degrees(), setup.range.1.to_degrees()])
+        .set("adjusted_rows", poses.iter().filter(|a| a.adjusted).count())
+        .set("gouge_rows", gouging.len())
+        .set("gouge_lines", gouging.iter().take(20).map(|&k| t.rows[k].line).collect::<Vec<_>>())
+        .set("gouge_tol_mm", setup.gouge_tol)
+        .set("largest_gouge_mm", poses.iter().filter_map(|a| a.gouge).fold(0.0, f64::max))
+        .set("largest_axis_unit_error", checks.unit)
+        .set("largest_tilt_error_rad", checks.tilt)
+        .set("largest_tip_distance_error_mm", checks.tip)
+        .set("seconds", started.elapsed().as_secs_f64())
+        .set("solve_seconds", seconds_solve)
+        .set("rows_per_second", t.rows.len() as f64 / seconds_solve.max(1e-9))
+        .set("threads", rayon::current_num_threads());
+    let edges: Vec<f64> = poses.iter().filter_map(|a| a.edge_radius).collect();
+    if !edges.is_empty() {
+        report.set("r_edge_min_mm", edges.iter().copied().fold(f64::INFINITY, f64::min));
+        report.set("r_edge_max_mm", edges.iter().copied().fold(0.0, f64::max));
+    }
+    let gaps: Vec<f64> = poses.iter().filter_map(|a| a.flank_gap).collect();
+    if !gaps.is_empty() {
+        report.set("flank_gap_min_deg", gaps.iter().copied().fold(f64::INFINITY, f64::min).to_degrees());
+        let corrections = poses.iter().map(|a| a.tilt.abs()).fold(0.0, f64::max);
+        report.set("largest_correction_deg", corrections.to_degrees());
+    }
+    if let Some(path) = &args.io.report {
+        report.write(path)?;
+    }
+    if let Some(&k) = gouging.first() {
+        let msg = format!(
+            "{} row(s) gouge the model by more than {} mm even at the best tilt in range (deepest {:.6} mm)",
+            gouging.len(),
+            setup.gouge_tol,
+            poses.iter().filter_map(|a| a.gouge).fold(0.0, f64::max)
+        );
+        let loc = Location::file(&input.name).line(t.rows[k].line);
+        if !args.allow_gouge {
+            return Err(Error::check(msg).at(loc));
+        }
+        cli::warn(&format!("{loc}: {msg}"));
+    }
+    let mut out = Output::new(args.io.output.as_deref());
+    table::write(&mut out, &t, &WriteOptions { decimals: args.decimals })?;
+    out.commit()
+}
+
+/// A pose's measured deviation from its definition above this fails the run (a bug, exit 1).
+const POSE_CHECK: f64 = 1e-9;
+
+/// Largest deviations of the written poses from what they promise, measured again.
+struct Checks {
+    unit: f64,
+    tilt: f64,
+    tip: f64,
+    worst: f64,
+}
+
+/// Measures every pose: axis of unit length; for the cylinder and ball the angle between axis
+/// and normal equal to |tilt| and the tip R (or the ball geometry) from the contact.
+fn self_check(setup: &Setup, cs: &[Contact], poses: &[Attitude]) -> Checks {
+    let mut c = Checks { unit: 0.0, tilt: 0.0, tip: 0.0, worst: 0.0 };
+    for (ct, a) in cs.iter().zip(poses) {
+        let axis = a.pose.axis;
+        c.unit = c.unit.max((axis.norm() - 1.0).abs());
+        let angle = axis.dot(&ct.normal).clamp(-1.0, 1.0).acos();
+        match setup.shape {
+            Shape::Cylinder { radius, .. } => {
+                c.tilt = c.tilt.max((angle - a.tilt.abs()).abs());
+                let d = a.pose.tip - ct.point;
+                c.tip = c.tip.max((d.norm() - radius).abs()).max(d.dot(&axis).abs());
+            }
+            Shape::Ball { radius, .. } => {
+                c.tilt = c.tilt.max((angle - a.tilt.abs()).abs());
+                let centre = a.pose.tip + axis * radius;
+                c.tip = c.tip.max(((centre - ct.point).norm() - radius).abs());
+            }
+            Shape::FlatMill { .. } => c.tilt = c.tilt.max(angle),
+            Shape::FlatType { .. } => {}
+        }
+    }
+    // acos near 0 loses half the digits: compare tilts through the sine instead when tiny.
+    c.worst = c.unit.max(c.tip).max(if c.tilt < 1e-7 { 0.0 } else { c.tilt });
+    c
+}

@@ -1,0 +1,24 @@
+# sphere smoothing, six-axis (paper 000 §3.2(1), §4.2(1), fig. 6, 15): tool-attitude turns the stylus
+# trace into tool tip, tool axis and spindle orientation of the φ25 cylindrical non-rotating tool
+# tilted −5° toward the feed (R' = 143 mm by eq. 1), the whole tool body checked against the model;
+# post-6axis writes six-axis NC for paper 000's A/C table machine, the edge orientation as a B
+# address. This file sorts before mk/sphere-smoothing.mk, so it names the directory itself.
+FILTERS += tool-attitude post-6axis
+SPHERE_SMOOTHING_6AXIS := $(OUT)/sphere-smoothing
+SPHERE_SMOOTHING_TOOL ?= data/tool-attitude/cylinder-phi25.json
+SPHERE_SMOOTHING_TILT ?= -5
+SPHERE_SMOOTHING_MACHINE ?= data/post-6axis/paper000-sixaxis-b.json
+SPHERE_SMOOTHING_FEED ?= 1000
+
+demo-sphere-smoothing: $(SPHERE_SMOOTHING_6AXIS)/tool.csv $(SPHERE_SMOOTHING_6AXIS)/part.nc
+
+$(SPHERE_SMOOTHING_6AXIS)/tool.csv $(SPHERE_SMOOTHING_6AXIS)/tool.json &: $(SPHERE_SMOOTHING_6AXIS)/cl.csv \
+  $(SPHERE_SMOOTHING_6AXIS)/model.json $(SPHERE_SMOOTHING_TOOL) $(RELEASE)/tool-attitude
+	$(RELEASE)/tool-attitude $< --tool $(SPHERE_SMOOTHING_TOOL) --tilt $(SPHERE_SMOOTHING_TILT) \
+	  --model $(SPHERE_SMOOTHING_6AXIS)/model.json \
+	  --report $(SPHERE_SMOOTHING_6AXIS)/tool.json -o $(SPHERE_SMOOTHING_6AXIS)/tool.csv
+
+$(SPHERE_SMOOTHING_6AXIS)/part.nc $(SPHERE_SMOOTHING_6AXIS)/part.json &: $(SPHERE_SMOOTHING_6AXIS)/tool.csv \
+  $(SPHERE_SMOOTHING_MACHINE) $(RELEASE)/post-6axis
+	$(RELEASE)/post-6axis $< --machine $(SPHERE_SMOOTHING_MACHINE) --feed $(SPHERE_SMOOTHING_FEED) \
+	  --report $(SPHERE_SMOOTHING_6AXIS)/part.json -o $(SPHERE_SMOOTHING_6AXIS)/part.nc

@@ -1,0 +1,353 @@
+//! End-to-end tests of `tool-attitude`: the built binary on contact streams generated on planes,
+//! spheres and cylinders (closed forms for every tool), the rear gouge in a concave region
+//! against its closed-form tilt, the flat-type tool against chord sagittas, real pipelines
+//! `stylus-trace | tool-attitude | post-6axis`, and bad input refused with file, line and column.
+
+use camkit::geom::{P3, V3};
+use e2e::{Work, data};
+use std::collections::HashMap;
+
+const BIN: &str = "tool-attitude";
+
+/// A table parsed by header name.
+struct Rows {
+    cols: HashMap<String, usize>,
+    rows: Vec<Vec<String>>,
+}
+
+impl Rows {
+    fn parse(csv: &str) -> Rows {
+        let mut lines = csv.lines();
+        let cols = lines.next().expect("header").split(',').enumerate().map(|(i, h)| (h.to_string(), i)).collect();
+        Rows { cols, rows: lines.map(|l| l.split(',').map(str::to_string).collect()).collect() }
+    }
+    fn num(&self, k: usize, name: &str) -> f64 {
+        let i = *self.cols.get(name).unwrap_or_else(|| panic!("no column {name}"));
+        self.rows[k][i].parse().unwrap_or_else(|_| panic!("{name} in row {k}: {:?}", self.rows[k][i]))
+    }
+    fn p3(&self, k: usize, x: &str, y: &str, z: &str) -> P3 {
+        P3::new(self.num(k, x), self.num(k, y), self.num(k, z))
+    }
+    fn tip(&self, k: usize) -> P3 {
+        self.p3(k, "x", "y", "z")
+    }
+    fn axis(&self, k: usize) -> V3 {
+        self.p3(k, "i", "j", "k").coords
+    }
+}
+
+/// A contact stream (one path) from contact points and unit normals, stylus radius `r`.
+fn stream(contacts: &[(P3, V3)], r: f64) -> String {
+    let mut s = String::from("path,x,y,z,px,py,pz,nx,ny,nz\n");
+    for (p, n) in contacts {
+        let c = p + n * r;
+        s += &format!("0,{},{},{},{},{},{},{},{},{}\n", c.x, c.y, c.z, p.x, p.y, p.z, n.x, n.y, n.z);
+    }
+    s
+}
+
+/// Contacts on a circle of radius `rho` about `centre` in the plane spanned by `u`, `w`, from
+/// angle `a0` in `count` points `da` apart; `inward` normals point to the centre (concave).
+fn circle(centre: P3, (u, w): (V3, V3), rho: f64, (a0, da, count): (f64, f64, usize), inward: bool) -> Vec<(P3, V3)> {
+    (0..count)
+        .map(|k| {
+            let a = a0 + da * k as f64;
+            let radial = u * a.cos() + w * a.sin();
+            (centre + radial * rho, if inward { -radial } else { radial })
+        })
+        .collect()
+}
+
+/// The unit tangent of the generated path at row k (central differences of a uniformly sampled
+/// circle are exactly tangent; the end rows are skipped by the checks).
+fn tangent(c: &[(P3, V3)], k: usize) -> V3 {
+    (c[k + 1].0 - c[k - 1].0).normalize()
+}
+
+fn angle(a: &V3, b: &V3) -> f64 {
+    a.cross(b).norm().atan2(a.dot(b))
+}
+
+const CYL: &str = r#"{"kind": "cylindrical-nonrotating", "radius": 12.5, "length": 40}"#;
+
+#[test]
+fn cylindrical_tool_closed_forms_on_plane_sphere_and_cylinder() {
+    let w = Work::new();
+    w.write("tool.json", CYL);
+    let line: Vec<(P3, V3)> = (0..20).map(|k| (P3::new(k as f64, 0.5 * k as f64, 0.0), V3::z())).collect();
+    let cases = [
+        ("plane", r#"{"surfaces": [{"type": "plane", "point": [0, 0, 0], "normal": [0, 0, 1]}]}"#, line),
+        (
+            "sphere",
+            r#"{"surfaces": [{"type": "sphere", "centre": [0, 0, -50], "radius": 50}]}"#,
+            circle(P3::new(0.0, 0.0, -50.0), (V3::new(0.6, 0.8, 0.0), V3::z()), 50.0, (1.2, 0.02, 20), false),
+        ),
+        (
+            "trough",
+            r#"{"surfaces": [{"type": "cylinder", "point": [0, 0, 400], "axis": [0, 1, 0], "radius": 400, "flip": true}]}"#,
+            circle(P3::new(0.0, 3.0, 400.0), (V3::x(), V3::z()), 400.0, (-1.8, 0.01, 20), true),
+        ),
+    ];
+    for (name, model, contacts) in &cases {
+        w.write("m.json", model);
+        w.write("cl.csv", stream(contacts, 12.5));
+        let out = w.run(BIN, &["cl.csv", "--tool", "tool.json", "--model", "m.json", "--report", "r.json"], b"").ok();
+        let t = Rows::parse(&out);
+        assert_eq!(t.rows.len(), contacts.len());
+        for k in 1..contacts.len() - 1 {
+            let (p, n) = contacts[k];
+            let (a, tip) = (t.axis(k), t.tip(k));
+            assert!((a.norm() - 1.0).abs() < 1e-12, "{name}: axis unit");
+            assert!((angle(&a, &n) - 5f64.to_radians()).abs() < 1e-9, "{name} row {k}: tilt");
+            let f = tangent(contacts, k);
+            assert!(a.dot(&n.cross(&f)).abs() < 1e-9, "{name} row {k}: axis in the plane of normal and feed");
+            assert!(a.dot(&f) > 0.0, "{name}: θ < 0 leans the axis toward the feed");
+            assert!(((tip - p).norm() - 12.5).abs() < 1e-9 && (tip - p).dot(&a).abs() < 1e-9, "{name}: tip");
+            assert!((t.num(k, "r_edge") - 12.5 / 5f64.to_radians().sin()).abs() < 1e-9);
+            assert!(t.num(k, "gouge") <= 1e-9, "{name}: no gouge");
+            assert_eq!(t.num(k, "tilt"), -5.0);
+            let s = t.num(k, "s");
+            let edge = camkit::kinematics::edge_direction(&a, s);
+            assert!((edge - (p - tip) / 12.5).norm() < 1e-9, "{name}: s turns the edge to the cutting point");
+        }
+    }
+}
+
+#[test]
+fn rear_gouge_in_a_concave_region_takes_the_closed_form_tilt() {
+    // Trough of radius ρ = 100: the tilted bottom face's rear rim point clears iff sin|θ| ≥ R/ρ.
+    let w = Work::new();
+    let rho = 100.0;
+    w.write(
+        "m.json",
+        r#"{"surfaces": [{"type": "cylinder", "point": [0, 0, 100], "axis": [0, 1, 0], "radius": 100, "flip": true}]}"#,
+    );
+    let contacts = circle(P3::new(0.0, 0.0, rho), (V3::x(), V3::z()), rho, (-1.7, 0.01, 10), true);
+    w.write("cl.csv", stream(&contacts, 12.5));
+    w.write("tool.json", CYL);
+    let args = ["cl.csv", "--tool", "tool.json", "--model", "m.json", "--gouge-tol", "1e-9", "--report", "r.json"];
+    let t = Rows::parse(&w.run(BIN, &args, b"").ok());
+    let expect = -(12.5f64 / rho).asin().to_degrees();
+    for k in 0..t.rows.len() {
+        assert!((t.num(k, "tilt") - expect).abs() < 1e-4, "row {k}: {} vs {expect}", t.num(k, "tilt"));
+        assert!(t.num(k, "gouge") <= 1e-9);
+    }
+    let report: serde_json::Value = serde_json::from_str(&w.read("r.json")).unwrap();
+    assert_eq!(report["adjusted_rows"], 10);
+    // A tool whose range stops at −6° cannot clear it: exit 1 naming the first row, no output.
+    w.write("short.json", r#"{"kind": "cylindrical-nonrotating", "radius": 12.5, "tilt_range": [-6, 0]}"#);
+    let bad = ["cl.csv", "--tool", "short.json", "--model", "m.json", "-o", "tool.csv"];
+    w.run(BIN, &bad, b"").fails(1, "cl.csv:2: 10 row(s) gouge the model");
+    assert!(!w.exists("tool.csv"));
+    // --allow-gouge writes them with the depth, which is the rear rim point's at −5°.
+    let mut allow = bad.to_vec();
+    allow.push("--allow-gouge");
+    let out = w.run(BIN, &allow, b"");
+    assert_eq!(out.status, 0, "{}", out.stderr);
+    let t = Rows::parse(&w.read("tool.csv"));
+    let a = 5f64.to_radians();
+    let depth = ((2.0 * 12.5 * a.cos()).powi(2) + (rho - 2.0 * 12.5 * a.sin()).powi(2)).sqrt() - rho;
+    assert!((t.num(3, "gouge") - depth).abs() < 1e-9, "{} vs {depth}", t.num(3, "gouge"));
+    assert_eq!(t.num(3, "tilt"), -5.0);
+}
+
+#[test]
+fn ball_and_flat_end_mill_closed_forms_on_a_sphere() {
+    let w = Work::new();
+    let centre = P3::new(0.0, 0.0, -50.0);
+    let contacts = circle(centre, (V3::new(0.6, 0.8, 0.0), V3::z()), 50.0, (1.0, 0.02, 15), false);
+    w.write("cl.csv", stream(&contacts, 5.0));
+    w.write("m.json", r#"{"surfaces": [{"type": "sphere", "centre": [0, 0, -50], "radius": 50}]}"#);
+    let ball = w
+        .run(
+            BIN,
+            &[
+                "cl.csv",
+                "--tool",
+                data("tool-attitude/ball-r5.json").to_str().unwrap(),
+                "--tilt",
+                "10",
+                "--model",
+                "m.json",
+            ],
+            b"",
+        )
+        .ok();
+    let t = Rows::parse(&ball);
+    assert!(!t.cols.contains_key("s"), "a rotating tool has no spindle orientation");
+    for k in 1..contacts.len() - 1 {
+        let (p, n) = contacts[k];
+        let a = t.axis(k);
+        assert!((angle(&a, &n) - 10f64.to_radians()).abs() < 1e-9);
+        assert!(a.dot(&tangent(&contacts, k)).abs() < 1e-9, "paper 003's tilt is across the feed");
+        // Ball centre on the offset sphere of radius 55 along the normal; tip r below it.
+        let c = t.tip(k) + a * 5.0;
+        assert!((c - (p + n * 5.0)).norm() < 1e-9);
+        assert!(((c - centre).norm() - 55.0).abs() < 1e-9);
+        assert!(t.num(k, "gouge") <= 1e-9);
+    }
+    let flat = w.run(BIN, &["cl.csv", "--tool", data("tool-attitude/flat-r5.json").to_str().unwrap()], b"").ok();
+    let t = Rows::parse(&flat);
+    for (k, (p, n)) in contacts.iter().enumerate() {
+        assert!((t.axis(k) - n).norm() < 1e-12 && (t.tip(k) - p).norm() < 1e-12);
+        // Eq. 3–4 against the sphere's own angles: a = polar angle of the normal, c its azimuth from +y.
+        let polar = (n.z).acos().to_degrees();
+        assert!((t.num(k, "ac_a") - polar).abs() < 1e-9);
+        assert!((t.num(k, "ac_c") - 0.6f64.atan2(0.8).to_degrees()).abs() < 1e-9);
+    }
+}
+
+/// A floor z = 0 and an R25 sphere centred at z = 10: the stylus of radius 1 touches both on a
+/// horizontal circle; the corner angle there is 180° − acos(−9/26).
+fn corner_stream() -> String {
+    let rs = 25.0f64;
+    let cs = P3::new(0.0, 0.0, 10.0);
+    let h = ((rs + 1.0).powi(2) - 81.0).sqrt();
+    let mut s = String::from("path,x,y,z,px,py,pz,nx,ny,nz,surface,p2x,p2y,p2z,n2x,n2y,n2z,surface2\n");
+    for k in 0..12 {
+        let a = 0.05 * k as f64;
+        let c = P3::new(h * a.cos(), h * a.sin(), 1.0);
+        let n2 = (c - cs) / (rs + 1.0);
+        let p2 = cs + n2 * rs;
+        s += &format!(
+            "0,{},{},{},{},{},0,0,0,1,floor,{},{},{},{},{},{},ball\n",
+            c.x, c.y, c.z, c.x, c.y, p2.x, p2.y, p2.z, n2.x, n2.y, n2.z
+        );
+    }
+    s
+}
+
+#[test]
+fn flat_type_tool_lies_on_the_control_surface() {
+    let w = Work::new();
+    w.write("cl.csv", corner_stream());
+    w.write(
+        "m.json",
+        r#"{"surfaces": [{"type": "plane", "name": "floor", "point": [0, 0, 0], "normal": [0, 0, 1]},
+        {"type": "sphere", "name": "ball", "centre": [0, 0, 10], "radius": 25}]}"#,
+    );
+    w.write("t3.json", r#"{"kind": "flat-nonrotating", "radius": 5, "included_angle": 65, "flank_length": 3}"#);
+    let corner = 180.0 - (-9.0f64 / 26.0).acos().to_degrees();
+    // P1 on the floor: no correction, the flank on the plane, the second flank off by corner − 65°.
+    let t = Rows::parse(&w.run(BIN, &["cl.csv", "--tool", "t3.json", "--model", "m.json"], b"").ok());
+    for k in 0..t.rows.len() {
+        assert!(t.num(k, "tilt").abs() < 1e-9);
+        assert!((t.num(k, "flank_gap") - (corner - 65.0)).abs() < 1e-9);
+        assert!(t.num(k, "gouge") < 1e-9, "flank on the floor");
+        let a = t.axis(k);
+        assert!((a.norm() - 1.0).abs() < 1e-12);
+        // Axis 32.5° up from the floor flank, which points away from the sphere.
+        assert!((a.z - 32.5f64.to_radians().sin()).abs() < 1e-9);
+        assert!(t.num(k, "s").is_finite());
+    }
+    // P3 on the sphere: the control point touches the offset sphere (R 26), the axis turns by
+    // asin(L / 2·26) and the straight flank's chord sinks by the sagitta 26 − √(26² − (L/2)²).
+    let out =
+        w.run(BIN, &["cl.csv", "--tool", "t3.json", "--model", "m.json", "--control", "p3", "--allow-gouge"], b"");
+    assert_eq!(out.status, 0);
+    let t = Rows::parse(&out.out());
+    let sag = 26.0 - (26.0f64.powi(2) - 1.5f64.powi(2)).sqrt();
+    for k in 0..t.rows.len() {
+        assert!((t.num(k, "tilt").abs() - (3.0f64 / 52.0).asin().to_degrees()).abs() < 1e-5, "{}", t.num(k, "tilt"));
+        assert!((t.num(k, "gouge") - sag).abs() < 1e-6, "{} vs {sag}", t.num(k, "gouge"));
+    }
+}
+
+#[test]
+fn pipelines_to_six_axis_nc() {
+    let w = Work::new();
+    // Sphere smoothing, a patch of the R500 sphere: stylus-trace | tool-attitude | post-6axis.
+    let model = data("stylus-trace/sphere-smoothing.json");
+    let model = model.to_str().unwrap();
+    let cl = w
+        .run("stylus-trace", &[model, "--mode", "scan", "-r", "12.5", "--pick", "2.5", "--region=-5,5,-5,5"], b"")
+        .ok();
+    let tool = data("tool-attitude/cylinder-phi25.json");
+    let out = w.run(BIN, &["--tool", tool.to_str().unwrap(), "--model", model], cl.as_bytes()).ok();
+    let t = Rows::parse(&out);
+    assert!(t.rows.len() > 10);
+    let centre = P3::new(0.0, 0.0, -500.0);
+    for k in 0..t.rows.len() {
+        let p = t.p3(k, "px", "py", "pz");
+        let n = (p - centre) / 500.0;
+        assert!((angle(&t.axis(k), &n) - 5f64.to_radians()).abs() < 1e-9);
+        assert!(((t.tip(k) - p).norm() - 12.5).abs() < 1e-9);
+        assert!((t.num(k, "r_edge") - 143.42141557).abs() < 1e-6, "paper 000: R' at −5°");
+    }
+    w.write("tool.csv", &out);
+    let machine = data("post-6axis/paper000-sixaxis-b.json");
+    let nc = w.run("post-6axis", &["tool.csv", "--machine", machine.to_str().unwrap(), "--feed", "1000"], b"").ok();
+    assert!(nc.lines().any(|l| l.starts_with("G0 ") && l.contains(" B")), "spindle orientation as B");
+    // Concave remainder: the two-surface trace | the flat-type tool with the model.
+    let model = data("stylus-trace/concave-remainder.json");
+    let model = model.to_str().unwrap();
+    let cl = w
+        .run(
+            "stylus-trace",
+            &[model, "--mode", "two-surface", "--surfaces", "free-form,R25", "-r", "1", "--chord-tol", "0.01"],
+            b"",
+        )
+        .ok();
+    let tool = data("tool-attitude/flat-type.json");
+    w.write("r.json", "");
+    let out =
+        w.run(BIN, &["--tool", tool.to_str().unwrap(), "--model", model, "--report", "r.json"], cl.as_bytes()).ok();
+    let report: serde_json::Value = serde_json::from_str(&w.read("r.json")).unwrap();
+    assert_eq!(report["gouge_rows"], 0);
+    assert!(report["flank_gap_min_deg"].as_f64().unwrap() > 4.0);
+    w.write("tool2.csv", &out);
+    let machine = data("post-6axis/paper000-sixaxis-m19.json");
+    let nc = w.run("post-6axis", &["tool2.csv", "--machine", machine.to_str().unwrap(), "--feed", "500"], b"").ok();
+    assert!(nc.contains("M19 R"));
+}
+
+#[test]
+fn edge_radius_chooses_the_tilt() {
+    let w = Work::new();
+    w.write("tool.json", CYL);
+    let contacts: Vec<(P3, V3)> = (0..3).map(|k| (P3::new(k as f64, 0.0, 0.0), V3::z())).collect();
+    w.write("cl.csv", stream(&contacts, 12.5));
+    let re = format!("{}", 12.5 / 20f64.to_radians().sin());
+    let t = Rows::parse(&w.run(BIN, &["cl.csv", "--tool", "tool.json", "--edge-radius", &re], b"").ok());
+    assert!((t.num(0, "tilt") + 20.0).abs() < 1e-9, "36.5 mm is the paper's −20°");
+    w.run(BIN, &["cl.csv", "--tool", "tool.json", "--edge-radius", "30"], b"").fails(2, "--edge-radius 30");
+    // With a depth of cut, eq. 1 itself: R' = 200 at T = 0.02 mm.
+    let t = Rows::parse(
+        &w.run(BIN, &["cl.csv", "--tool", "tool.json", "--edge-radius", "200", "--cut-depth", "0.02"], b"").ok(),
+    );
+    assert!((t.num(0, "r_edge") - 200.0).abs() < 1e-9);
+}
+
+#[test]
+fn bad_input_is_refused_with_its_place() {
+    let w = Work::new();
+    w.write("tool.json", CYL);
+    let ok: Vec<(P3, V3)> = (0..3).map(|k| (P3::new(k as f64, 0.0, 0.0), V3::z())).collect();
+    let run = |csv: &str, extra: &[&str]| {
+        w.write("cl.csv", csv);
+        let mut args = vec!["cl.csv", "--tool", "tool.json", "-o", "out.csv"];
+        args.extend_from_slice(extra);
+        w.run(BIN, &args, b"")
+    };
+    // A path of one row: no feed direction.
+    let one = "path,x,y,z,px,py,pz,nx,ny,nz\n0,0,0,12.5,0,0,0,0,0,1\n1,1,0,12.5,1,0,0,0,0,1\n1,2,0,12.5,2,0,0,0,0,1\n";
+    run(one, &[]).fails(2, "cl.csv:2: path 0 has 1 row");
+    // A non-unit normal: line and column of nx.
+    let bad = stream(&ok, 12.5).replace(",1,0,0,0,0,1\n", ",1,0,0,0,0,1.5\n");
+    run(&bad, &[]).fails(2, "cl.csv:3:8 (nx): the normal (0, 0, 1.5) is not a unit vector");
+    let zero = stream(&ok, 12.5).replacen("0,0,1\n", "0,0,0\n", 1);
+    run(&zero, &[]).fails(2, "cl.csv:2:8 (nx)");
+    run("path,x,y,z\n0,1,2,3\n", &[]).fails(2, "missing column `px`");
+    run(&stream(&ok, 12.5).replacen("0,0,1\n", "0,0,nan\n", 1), &[]).fails(2, "cl.csv:2:10 (nz)");
+    run(&stream(&ok, 12.5), &["--tilt", "-25"]).fails(2, "tilt -25° is outside the tool's range [-20, 0]");
+    run(&stream(&ok, 12.5), &["--tilt", "3"]).fails(2, "outside the tool's range");
+    w.write("tool.json", r#"{"kind": "cylindrical-nonrotating"}"#);
+    run(&stream(&ok, 12.5), &[]).fails(2, "missing field `radius`");
+    w.write("tool.json", r#"{"kind": "flat-nonrotating", "radius": 5, "included_angle": 60}"#);
+    run(&stream(&ok, 12.5), &[]).fails(2, "tool.json (flank_length)");
+    w.write("tool.json", r#"{"kind": "flat-nonrotating", "radius": 5, "included_angle": 60, "flank_length": 2}"#);
+    run(&stream(&ok, 12.5), &[]).fails(2, "missing column `p2x`");
+    w.write("tool.json", r#"{"kind": "bull", "radius": 5, "corner_radius": 1}"#);
+    run(&stream(&ok, 12.5), &[]).fails(2, "tool.json (kind)");
+    assert!(!w.exists("out.csv"), "nothing written on bad input");
+}
