@@ -266,6 +266,22 @@ mod tests {
         }
     }
 
+    /// The read-back check runs chunks in parallel: the same figures on one thread as on four,
+    /// over more blocks than one chunk holds.
+    #[test]
+    fn read_back_is_the_same_for_any_thread_count() {
+        let (m, chain) = machine("paper000-sixaxis-b.json");
+        let rows = pass(readback::CHUNK * 2 + 100, 30.0, 90.0, 2.0, true);
+        let posted = post(&rows, "t", &m, &chain, &Settings::default(), vec![]).expect("posts");
+        assert!(posted.check.blocks > 2 * readback::CHUNK, "{:?}", posted.check);
+        let on = |threads: usize| {
+            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+            pool.install(|| check_text(&posted.text, &rows, &m, &chain).unwrap())
+        };
+        assert_eq!(on(1), posted.check);
+        assert_eq!(on(4), posted.check);
+    }
+
     #[test]
     fn arcs_and_slerp() {
         let (a, b) = (V3::x(), V3::y());

@@ -9,6 +9,7 @@ use camkit::gcode::{AXIS_LETTERS, AxisProgram, Motion};
 use camkit::geom::{P3, V3};
 use camkit::kinematics::{Chain, Joints, principal_deg};
 use camkit::table::{Col, Move, Row, Schema, Table};
+use rayon::prelude::*;
 
 /// How to read a program for one machine.
 #[derive(Clone, Debug)]
@@ -158,29 +159,119 @@ fn param(p: &P3, a: &P3, b: &P3) -> f64 {
     if l2 > 0.0 { ((p - a).dot(&d) / l2).clamp(0.0, 1.0) } else { 0.0 }
 }
 
+/// Blocks (and CL rows) per chunk of the parallel check: fixed, so that the figures do not depend
+/// on the number of threads. Each chunk but the first starts its nearest-segment search with a
+/// full search. A windowed search can only over-report a distance (it is to a real segment), never
+/// under-report it.
+pub const CHUNK: usize = 8192;
+
 /// Compares a program with the CL rows it was made from: every feed block sampled
 /// `samples_per_block` times along the controller's linear interpolation of every axis against
 /// the CL polyline (tip, axis, spindle orientation), and every CL row against the program's path.
+/// Chunks of blocks and of rows run in parallel; the result is the same for any thread count.
 pub fn verify(cl: &[Cl], poses: &[Option<NcPose>], r: &Reading, samples_per_block: usize, far: f64) -> Deviation {
     let segs: Vec<(usize, usize)> = (1..cl.len()).filter(|&i| !cl[i].rapid).map(|i| (i - 1, i)).collect();
-    let mut dev = Deviation::default();
-    let mut hint = 0;
-    let mut path: Vec<P3> = Vec::with_capacity(poses.len());
+    // Feed blocks as (start, end) poses in program order; a G53 block or an unknown position
+    // breaks the chain.
+    let mut blocks: Vec<(&NcPose, &NcPose)> = Vec::with_capacity(poses.len());
     let mut prev: Option<&NcPose> = None;
     for pose in poses {
         let Some(b) = pose else {
             prev = None;
             continue;
         };
-        path.push(r.at(&b.joints).0);
-        let Some(a) = prev.filter(|_| !b.rapid) else {
-            prev = Some(b);
-            continue;
-        };
-        prev = Some(b);
-        if segs.is_empty() {
-            continue;
+        if let Some(a) = prev.filter(|_| !b.rapid) {
+            blocks.push((a, b));
         }
+        prev = Some(b);
+    }
+    let path: Vec<P3> = poses.par_iter().filter_map(|p| p.as_ref()).map(|p| r.at(&p.joints).0).collect();
+    let mut dev = Deviation::default();
+    if !segs.is_empty() {
+        // The first chunk starts its search at the first segment, as a sequential check would.
+        let parts: Vec<Deviation> = blocks
+            .par_chunks(CHUNK)
+            .enumerate()
+            .map(|(c, chunk)| check_blocks(cl, &segs, chunk, (c == 0).then_some(0), r, samples_per_block, far))
+            .collect();
+        for p in parts {
+            if p.tip > dev.tip {
+                (dev.tip, dev.tip_line) = (p.tip, p.tip_line);
+            }
+            if p.axis_deg > dev.axis_deg {
+                (dev.axis_deg, dev.axis_line) = (p.axis_deg, p.axis_line);
+            }
+            dev.spindle_deg = dev.spindle_deg.max(p.spindle_deg);
+            dev.blocks += p.blocks;
+            dev.samples += p.samples;
+        }
+    }
+    // Coverage: every CL row lies on the program's path.
+    if path.is_empty() {
+        dev.coverage = f64::INFINITY;
+        return dev;
+    }
+    let parts: Vec<(f64, usize)> = cl
+        .par_chunks(CHUNK)
+        .enumerate()
+        .map(|(c, rows)| {
+            let mut worst = (0.0, c * CHUNK);
+            let mut j = (c == 0).then_some(0);
+            for (i, row) in rows.iter().enumerate() {
+                let (k, d) = nearest_on_path(&row.tip, &path, j, far);
+                j = Some(k);
+                if d > worst.0 {
+                    worst = (d, c * CHUNK + i);
+                }
+            }
+            worst
+        })
+        .collect();
+    for (d, i) in parts {
+        if d > dev.coverage {
+            (dev.coverage, dev.coverage_row) = (d, i);
+        }
+    }
+    dev
+}
+
+/// Index of the program path's segment (or last point) nearest `p` and its distance: searched
+/// near `hint` first, everywhere when there is no hint or nothing within `far` near it.
+fn nearest_on_path(p: &P3, path: &[P3], hint: Option<usize>, far: f64) -> (usize, f64) {
+    let scan = |lo: usize, hi: usize, best: &mut (usize, f64)| {
+        for k in lo..hi {
+            let d = if k + 1 < path.len() { point_segment(p, &path[k], &path[k + 1]) } else { (p - path[k]).norm() };
+            if d < best.1 {
+                *best = (k, d);
+            }
+        }
+    };
+    let mut best = (hint.unwrap_or(0), f64::INFINITY);
+    match hint {
+        Some(j) => {
+            scan(j.saturating_sub(2), (j + 64).min(path.len()), &mut best);
+            if best.1 > far {
+                scan(0, path.len(), &mut best);
+            }
+        }
+        None => scan(0, path.len(), &mut best),
+    }
+    best
+}
+
+/// The block part of [`verify`] for one chunk of consecutive feed blocks, the nearest-segment
+/// search starting at `hint` (none: a full search).
+fn check_blocks(
+    cl: &[Cl],
+    segs: &[(usize, usize)],
+    blocks: &[(&NcPose, &NcPose)],
+    mut hint: Option<usize>,
+    r: &Reading,
+    samples_per_block: usize,
+    far: f64,
+) -> Deviation {
+    let mut dev = Deviation::default();
+    for &(a, b) in blocks {
         dev.blocks += 1;
         for k in 0..=samples_per_block {
             let t = k as f64 / samples_per_block as f64;
@@ -192,8 +283,12 @@ pub fn verify(cl: &[Cl], poses: &[Option<NcPose>], r: &Reading, samples_per_bloc
                 ],
             };
             let (tip, axis) = r.at(&q);
-            let (seg, d) = nearest(&tip, cl, &segs, hint, far);
-            hint = seg;
+            // Without a hint (a chunk but the first), a full search (a negative `far`).
+            let (seg, d) = match hint {
+                Some(h) => nearest(&tip, cl, segs, h, far),
+                None => nearest(&tip, cl, segs, 0, -1.0),
+            };
+            hint = Some(seg);
             dev.samples += 1;
             if d > dev.tip {
                 dev.tip = d;
@@ -218,36 +313,6 @@ pub fn verify(cl: &[Cl], poses: &[Option<NcPose>], r: &Reading, samples_per_bloc
                     dev.spindle_deg = dev.spindle_deg.max(principal_deg(have - want_s).abs());
                 }
             }
-        }
-    }
-    // Coverage: every CL row lies on the program's path.
-    let mut j = 0usize;
-    for (i, row) in cl.iter().enumerate() {
-        if path.is_empty() {
-            dev.coverage = f64::INFINITY;
-            break;
-        }
-        let mut best = (j, f64::INFINITY);
-        let scan = |lo: usize, hi: usize, best: &mut (usize, f64)| {
-            for k in lo..hi {
-                let d = if k + 1 < path.len() {
-                    point_segment(&row.tip, &path[k], &path[k + 1])
-                } else {
-                    (row.tip - path[k]).norm()
-                };
-                if d < best.1 {
-                    *best = (k, d);
-                }
-            }
-        };
-        scan(j.saturating_sub(2), (j + 64).min(path.len()), &mut best);
-        if best.1 > far {
-            scan(0, path.len(), &mut best);
-        }
-        j = best.0;
-        if best.1 > dev.coverage {
-            dev.coverage = best.1;
-            dev.coverage_row = i;
         }
     }
     dev
