@@ -151,12 +151,12 @@ proptest! {
     }
 
     /// Contour levels on a torus with a tilted axis: every level's loops close on the offset torus.
-    /// The levels cut the tube on every side (|z| ≤ 2 while the offset tube's top and bottom
-    /// ridges stay beyond ±3.6): a level grazing a horizontal spot of the CL surface is where the
-    /// in-plane correction has no slope to work with and the tracer stops (exit 1).
+    /// Levels fall anywhere through the tube, also just under the tilted tube's top ridge or over
+    /// its bottom one, where the offset surface is nearly horizontal and the correction in the
+    /// level has little slope to work with.
     #[test]
     fn contour_levels_close_on_the_offset_torus(
-        theta in 0.0..std::f64::consts::TAU, phi in 0.0..0.15f64, r in 0.5..4.0f64, z in -2.0..2.0f64,
+        theta in 0.0..std::f64::consts::TAU, phi in 0.0..0.4f64, r in 0.5..4.0f64, z in -8.0..8.0f64,
     ) {
         let axis = unit(theta, phi);
         let m = model(&format!(
