@@ -242,6 +242,7 @@ pub(crate) fn shape_offset(loops: &[Contour], d: f64, (pos, dist): Eps) -> Vec<C
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::contour::Defect;
     use crate::geom::P2;
     use std::f64::consts::PI;
 
@@ -256,6 +257,25 @@ mod tests {
         assert!((outside.contours[0].area() - PI * 12.5 * 12.5).abs() < 1e-9);
         let gone = offset_contour(&c, 10.5, Side::Left, &OffsetOptions::default()).unwrap();
         assert!(gone.contours.is_empty());
+    }
+
+    #[test]
+    fn check_offset_finds_missing_and_stray_loops() {
+        // Two rooms joined by a neck narrower than 2R: the offset is two loops.
+        let pts = [(0.0, 0.0), (20.0, 0.0), (20.0, 9.0), (30.0, 9.0), (30.0, 0.0), (50.0, 0.0)];
+        let mut all: Vec<P2> = pts.iter().map(|&(x, y)| P2::new(x, y)).collect();
+        all.extend(pts.iter().rev().map(|&(x, y)| P2::new(x, 20.0 - y)));
+        let rooms = Contour::polygon(&all, true);
+        let o = offset_contour(&rooms, 1.5, Side::Left, &OffsetOptions::default()).unwrap();
+        assert_eq!(o.contours.len(), 2);
+        let ok = check_offset(&[&rooms], &o.contours, 1.5, Side::Left, true, 1e-6);
+        assert!(ok.is_ok(), "{ok:?}");
+        let one = check_offset(&[&rooms], &o.contours[..1], 1.5, Side::Left, true, 1e-6);
+        assert!(matches!(one, Err(Defect::Missing(_))), "{one:?}");
+        let far = check_offset(&[&rooms], &o.contours, 1.5 - 1e-5, Side::Left, true, 1e-6);
+        assert!(matches!(far, Err(Defect::Stray(..))), "{far:?}");
+        let near = check_offset(&[&rooms], &o.contours, 1.5 + 1e-5, Side::Left, true, 1e-6);
+        assert!(matches!(near, Err(Defect::Gouge(..))), "{near:?}");
     }
 
     #[test]

@@ -9,7 +9,7 @@
 
 use super::{Contour, Seg};
 use crate::geom::{P2, V2, cross2};
-use cavalier_contours::static_aabb2d_index::{StaticAABB2DIndex, StaticAABB2DIndexBuilder};
+use cavalier_contours::static_aabb2d_index::{Control, StaticAABB2DIndex, StaticAABB2DIndexBuilder};
 use rayon::prelude::*;
 
 /// What the verification of an offset measured.
@@ -194,14 +194,24 @@ impl SegSet {
     }
 
     /// Distance from `p` to the nearest piece, looking no farther than `reach` (∞ beyond it).
+    /// Runs are visited nearest first and the search stops at the first run farther than the best
+    /// distance so far: a probe near one part of a large contour never walks the rest of it.
     pub fn distance(&self, p: &P2, reach: f64) -> f64 {
         let mut best = f64::INFINITY;
-        for i in self.near(p, p, reach) {
-            let (c, r) = self.circles[i];
-            if (p - c).norm() - r < best {
-                best = best.min(self.segs[i].distance_to(p));
+        let Some(ix) = &self.index else { return best };
+        let _: Control<()> = ix.visit_neighbors(p.x, p.y, &mut |k: usize, d2: f64| {
+            if d2.sqrt() > reach.min(best) {
+                return Control::Break(());
             }
-        }
+            let (_, _, a, b) = self.chunks[k];
+            for i in a..b {
+                let (c, r) = self.circles[i];
+                if (p - c).norm() - r < best {
+                    best = best.min(self.segs[i].distance_to(p));
+                }
+            }
+            Control::Continue
+        });
         best
     }
 
