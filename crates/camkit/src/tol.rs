@@ -35,6 +35,11 @@ pub const CLEAN_EPS: f64 = 1e-9;
 /// reader accepts; the arc is then taken through both ends with its sweep.
 pub const ARC_END_MISMATCH: f64 = 1e-3;
 
+/// A point set whose smallest principal spread (standard deviation) is below this fraction of its
+/// largest lies on one plane (or, for the middle spread, one line): an element it cannot
+/// determine (a sphere from coplanar points) is refused instead of fitted.
+pub const DEGENERATE_SPREAD_REL: f64 = 1e-9;
+
 /// `a` and `b` differ by at most `eps`.
 pub fn near(a: f64, b: f64, eps: f64) -> bool {
     (a - b).abs() <= eps

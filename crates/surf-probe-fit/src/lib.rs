@@ -1,0 +1,19 @@
+//! `surf-probe-fit`: on-machine measurement of a workpiece (paper 002 §2–4).
+//!
+//! Geometric least-squares fits of a sphere, plane, circle and cylinder ([`shapes`], on the
+//! Levenberg–Marquardt engine of [`lsq`]), reference data with known solutions ([`reference`]),
+//! a laser displacement sensor simulator ([`sensor`]), raw sensor records turned into points
+//! through the machine's kinematics ([`records`]), the 3-axis raster as a rough Delaunay surface
+//! and the 5-axis measuring plan along its normals ([`rough`]), and the fit as the workpiece frame
+//! `post-6axis` reads ([`frame`]).
+
+pub mod frame;
+pub mod lsq;
+pub mod records;
+pub mod reference;
+pub mod rng;
+pub mod rough;
+pub mod sensor;
+pub mod shapes;
+
+pub use shapes::{Fit, FitError, Kind, Options, Robust, Shape, fit};

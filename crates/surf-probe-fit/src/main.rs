@@ -1,0 +1,598 @@
+//! `surf-probe-fit`: on-machine measurement of a workpiece's shape and pose (paper 002 §2–4).
+
+use camkit::cli::{self, IoArgs};
+use camkit::doc::machine::Machine;
+use camkit::error::{Error, Location, Result};
+use camkit::geom::{P3, V3};
+use camkit::io::{Input, Output};
+use camkit::kinematics::{Chain, Joints, Link};
+use camkit::report::Report;
+use camkit::table::{self, Col, Field, Move, Row, Schema, Table, WriteOptions};
+use clap::{Parser, Subcommand, ValueEnum};
+use std::collections::HashMap;
+use std::path::PathBuf;
+use std::process::ExitCode;
+use std::time::Instant;
+use surf_probe_fit::records::{self, Record};
+use surf_probe_fit::reference::{self, Spec};
+use surf_probe_fit::rng::Rng;
+use surf_probe_fit::rough::{self, Probe};
+use surf_probe_fit::sensor::Sensor;
+use surf_probe_fit::{FitError, Kind, Options, Robust, Shape, frame, shapes};
+
+#[derive(Parser, Debug)]
+#[command(
+    name = "surf-probe-fit",
+    version,
+    allow_negative_numbers = true,
+    about = "Measure a workpiece on the machine and fit its shape and pose: the workpiece frame for post-6axis.",
+    long_about = "Measure a workpiece on the machine and fit its shape and pose (paper 002 §2-4): a 3-axis \
+raster with a laser displacement sensor (`raster`, `simulate`), a rough Delaunay surface of it and the 5-axis \
+measuring plan along its normals (`plan`, a toolpath table post-6axis posts), raw records turned into points \
+through the machine's kinematics (`points`), and the geometric least-squares fit of a sphere, plane, circle or \
+cylinder written as the workpiece frame document post-6axis reads with --frame (`fit`). `reference` writes \
+point sets with known least-squares solutions (ISO 10360-6 style).",
+    after_help = "Formats: docs/formats.md#surf-probe-fit. Exit status: 0 done, 1 the fit did not converge, 2 bad input."
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand, Debug)]
+enum Command {
+    /// Fit an element to measured points (x,y,z) or raw sensor records (axes + reading); write the
+    /// workpiece frame document (JSON) with the fit in it.
+    #[command(allow_negative_numbers = true)]
+    Fit(FitArgs),
+    /// Write a 3-axis raster of sensor poses (tool axis +Z) as a toolpath table.
+    #[command(allow_negative_numbers = true)]
+    Raster(RasterArgs),
+    /// Simulate the laser sensor over a known element along the poses of a toolpath table: raw
+    /// records (axis positions, reading).
+    #[command(allow_negative_numbers = true)]
+    Simulate(SimulateArgs),
+    /// Turn raw sensor records into measured points through the machine's kinematics.
+    #[command(allow_negative_numbers = true)]
+    Points(PointsArgs),
+    /// The 5-axis measuring plan: sensor poses along the normals of the rough surface (Delaunay
+    /// triangulation of the points) or of a fitted sphere, at the stand-off, as a toolpath table.
+    #[command(allow_negative_numbers = true)]
+    Plan(PlanArgs),
+    /// Write a reference point set with a known least-squares solution (ISO 10360-6 style).
+    #[command(allow_negative_numbers = true)]
+    Reference(ReferenceArgs),
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+enum ShapeArg {
+    Sphere,
+    Plane,
+    Circle,
+    Cylinder,
+}
+
+impl ShapeArg {
+    fn kind(self) -> Kind {
+        match self {
+            ShapeArg::Sphere => Kind::Sphere,
+            ShapeArg::Plane => Kind::Plane,
+            ShapeArg::Circle => Kind::Circle,
+            ShapeArg::Cylinder => Kind::Cylinder,
+        }
+    }
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+enum RobustArg {
+    /// Plain least squares.
+    None,
+    /// Huber weights (iteratively reweighted).
+    Huber,
+}
+
+#[derive(clap::Args, Debug)]
+struct FitArgs {
+    #[command(flatten)]
+    io: IoArgs,
+    /// Element to fit.
+    #[arg(long, value_enum, default_value_t = ShapeArg::Sphere)]
+    shape: ShapeArg,
+    /// Machine document (JSON) for raw records (a `reading` column); without it records are
+    /// 3-axis (beam along −Z).
+    #[arg(long, short = 'm', value_name = "FILE")]
+    machine: Option<String>,
+    /// Robust weighting against outliers.
+    #[arg(long, value_enum, default_value_t = RobustArg::None)]
+    robust: RobustArg,
+    /// Huber threshold in robust standard deviations.
+    #[arg(long, default_value_t = 1.345, value_name = "K")]
+    huber_k: f64,
+    /// Noise amplification above which a parameter is reported as poorly determined.
+    #[arg(long, default_value_t = shapes::DEFAULT_MAX_AMPLIFICATION, value_name = "FACTOR")]
+    max_amplification: f64,
+    /// The true element (a shape or frame document): its errors go into the report.
+    #[arg(long, value_name = "FILE")]
+    truth: Option<String>,
+}
+
+#[derive(clap::Args, Debug)]
+struct OutArgs {
+    /// Write the output to FILE (whole or not at all) instead of standard output.
+    #[arg(short = 'o', long = "output", value_name = "FILE")]
+    output: Option<PathBuf>,
+    /// Write figures of the run to FILE as JSON.
+    #[arg(long, value_name = "FILE")]
+    report: Option<PathBuf>,
+}
+
+#[derive(clap::Args, Debug)]
+struct RasterArgs {
+    #[command(flatten)]
+    out: OutArgs,
+    /// X range `MIN,MAX` (mm).
+    #[arg(long, value_name = "MIN,MAX", value_delimiter = ',', allow_hyphen_values = true, required = true)]
+    x: Vec<f64>,
+    /// Y range `MIN,MAX` (mm).
+    #[arg(long, value_name = "MIN,MAX", value_delimiter = ',', allow_hyphen_values = true, required = true)]
+    y: Vec<f64>,
+    /// Spacing of the raster in X and Y (mm).
+    #[arg(long, default_value_t = 2.0, value_name = "MM")]
+    step: f64,
+    /// Height of the sensor's reference point (mm).
+    #[arg(long, value_name = "MM")]
+    z: f64,
+}
+
+#[derive(clap::Args, Debug)]
+struct SensorArgs {
+    /// Sensor stand-off (mm): nominal distance from its reference point to the surface.
+    #[arg(long, default_value_t = Sensor::default().standoff, value_name = "MM")]
+    standoff: f64,
+    /// Half measuring range about the stand-off (mm).
+    #[arg(long, default_value_t = Sensor::default().range, value_name = "MM")]
+    range: f64,
+    /// Reading noise at normal incidence, standard deviation (mm).
+    #[arg(long, default_value_t = Sensor::default().noise, value_name = "MM")]
+    noise: f64,
+    /// Systematic error coefficient (mm): readings are longer by it × (1/cos θ − 1).
+    #[arg(long, default_value_t = Sensor::default().slope_error, value_name = "MM")]
+    slope_error: f64,
+    /// Largest incidence angle that returns a reading (degrees).
+    #[arg(long, default_value_t = Sensor::default().max_incidence, value_name = "DEG")]
+    max_incidence: f64,
+}
+
+#[derive(clap::Args, Debug)]
+struct SimulateArgs {
+    #[command(flatten)]
+    io: IoArgs,
+    /// The true element in table coordinates (shape document, JSON).
+    #[arg(long, value_name = "FILE")]
+    shape: String,
+    /// Machine document: records carry its axis positions (default: 3-axis).
+    #[arg(long, short = 'm', value_name = "FILE")]
+    machine: Option<String>,
+    #[command(flatten)]
+    sensor: SensorArgs,
+    /// Random seed of the noise.
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+}
+
+#[derive(clap::Args, Debug)]
+struct PointsArgs {
+    #[command(flatten)]
+    io: IoArgs,
+    /// Machine document of the records (default: 3-axis).
+    #[arg(long, short = 'm', value_name = "FILE")]
+    machine: Option<String>,
+}
+
+#[derive(clap::Args, Debug)]
+struct PlanArgs {
+    #[command(flatten)]
+    io: IoArgs,
+    /// Plan on this fitted sphere (a frame or shape document) instead of the rough surface.
+    #[arg(long, value_name = "FILE")]
+    fit: Option<String>,
+    /// Sensor stand-off (mm): the pose's tip is this far from the surface along the normal.
+    #[arg(long, default_value_t = Sensor::default().standoff, value_name = "MM")]
+    standoff: f64,
+    /// Rough surface: probe every N-th point.
+    #[arg(long, default_value_t = 1, value_name = "N")]
+    every: usize,
+    /// Rough surface: facets steeper than this are dropped (degrees).
+    #[arg(long, default_value_t = 80.0, value_name = "DEG")]
+    max_slope: f64,
+    /// Sphere: largest angle from the top (degrees).
+    #[arg(long, default_value_t = 80.0, value_name = "DEG")]
+    max_polar: f64,
+    /// Sphere: spacing of rings and of points along them (degrees).
+    #[arg(long, default_value_t = 10.0, value_name = "DEG")]
+    ring_step: f64,
+}
+
+#[derive(clap::Args, Debug)]
+struct ReferenceArgs {
+    #[command(flatten)]
+    out: OutArgs,
+    /// Element.
+    #[arg(long, value_enum, default_value_t = ShapeArg::Sphere)]
+    shape: ShapeArg,
+    /// Centre (sphere, circle) or axis point (cylinder) or plane point `X,Y,Z`.
+    #[arg(long, value_delimiter = ',', allow_hyphen_values = true, default_values_t = [0.0, 0.0, 0.0])]
+    centre: Vec<f64>,
+    /// Normal (plane, circle) or axis (cylinder) `X,Y,Z`.
+    #[arg(long, value_delimiter = ',', allow_hyphen_values = true, default_values_t = [0.0, 0.0, 1.0])]
+    axis: Vec<f64>,
+    /// Radius (mm).
+    #[arg(long, default_value_t = 25.0)]
+    radius: f64,
+    /// Sphere: cap half-angle (deg); cylinder: length (mm); plane: half-width (mm); circle: arc (deg).
+    #[arg(long, default_value_t = 180.0)]
+    extent: f64,
+    /// Number of points.
+    #[arg(long, default_value_t = 1000)]
+    points: usize,
+    /// Residual amplitude (mm).
+    #[arg(long, default_value_t = 0.01)]
+    amplitude: f64,
+    /// Random seed.
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+}
+
+fn main() -> ExitCode {
+    cli::run("surf-probe-fit", || match Cli::parse().command {
+        Command::Fit(a) => run_fit(a),
+        Command::Raster(a) => run_raster(a),
+        Command::Simulate(a) => run_simulate(a),
+        Command::Points(a) => run_points(a),
+        Command::Plan(a) => run_plan(a),
+        Command::Reference(a) => run_reference(a),
+    })
+}
+
+fn positive(v: f64, what: &str) -> Result<f64> {
+    if v.is_finite() && v > 0.0 {
+        Ok(v)
+    } else {
+        Err(Error::input(format!("{what} must be a positive number, got {v}")))
+    }
+}
+
+/// The chain in table coordinates (frame at zero): the machine's, or a 3-axis machine.
+fn table_chain(machine: Option<&str>) -> Result<(Chain, f64)> {
+    match machine {
+        Some(path) => {
+            let (m, chain) = Machine::read(path)?;
+            Ok((chain.with_frame(V3::zeros()), m.singular_cone.to_radians()))
+        }
+        None => Ok((Chain::new(vec![Link::Linear], vec![]).map_err(Error::runtime)?, 0.0)),
+    }
+}
+
+/// A shape document: `{"shape": "sphere", "centre": [..], "radius": ..}`, or a frame document
+/// whose `fit` holds one.
+fn read_shape(path: &str) -> Result<Shape> {
+    let input = Input::open(path)?;
+    let v: serde_json::Value = camkit::json::from_input(&input)?;
+    let (v, at) = match v.get("fit") {
+        Some(f) => (f.clone(), "fit"),
+        None => (v, "shape"),
+    };
+    serde_json::from_value::<Shape>(v).map_err(|e| camkit::json::field_error(&input.name, at, e.to_string()))
+}
+
+/// Column position (1-based) of the extra column `i` in the header.
+fn extra_column(schema: &Schema, i: usize) -> u64 {
+    schema.fields.iter().position(|f| *f == Field::Extra(i)).map_or(0, |p| p as u64 + 1)
+}
+
+fn extra_number(t: &Table, row: &Row, name: &str, file: &str) -> Result<Option<f64>> {
+    let Some(i) = t.schema.extra_index(name) else { return Ok(None) };
+    let text = row.extra[i].as_str();
+    camkit::num::parse_finite(text).map(Some).map_err(|e| {
+        Error::input(e.message(text))
+            .at(Location::file(file).line(row.line).column(extra_column(&t.schema, i)).field(name))
+    })
+}
+
+/// Raw records of a table: axis positions `x, y, z`, the chain's rotary addresses (lower case,
+/// 0 when absent) and `reading`.
+fn read_records(t: &Table, chain: &Chain, file: &str) -> Result<Vec<Record>> {
+    let names: Vec<String> = chain.rotaries().iter().map(|r| r.address.to_ascii_lowercase().to_string()).collect();
+    t.rows
+        .iter()
+        .map(|row| {
+            let reading = extra_number(t, row, "reading", file)?
+                .ok_or_else(|| Error::input("missing column `reading`").at(Location::file(file).line(row.line)))?;
+            let mut rot = [0.0; 2];
+            for (k, n) in names.iter().enumerate() {
+                rot[k] = extra_number(t, row, n, file)?.unwrap_or(0.0);
+            }
+            Ok(Record { joints: Joints { xyz: row.pos.coords, rot }, reading })
+        })
+        .collect()
+}
+
+/// Points of a table: raw records through the kinematics when it has a `reading` column, the
+/// `x, y, z` columns otherwise. Duplicate points are refused.
+fn read_points(input: &Input, machine: Option<&str>) -> Result<(Table, Vec<P3>)> {
+    let t = table::read(input, &[Col::X, Col::Y])?;
+    let pts: Vec<P3> = if t.schema.extra_index("reading").is_some() {
+        let (chain, _) = table_chain(machine)?;
+        read_records(&t, &chain, &input.name)?.iter().map(|r| records::to_point(&chain, r)).collect()
+    } else {
+        t.rows.iter().map(|r| r.pos).collect()
+    };
+    let mut seen: HashMap<[u64; 3], u64> = HashMap::with_capacity(pts.len());
+    for (p, row) in pts.iter().zip(&t.rows) {
+        let key = [p.x, p.y, p.z].map(|v| (v + 0.0).to_bits());
+        if let Some(first) = seen.insert(key, row.line) {
+            return Err(Error::input(format!("duplicate point: the same as line {first}"))
+                .at(Location::file(&input.name).line(row.line)));
+        }
+    }
+    Ok((t, pts))
+}
+
+fn run_fit(args: FitArgs) -> Result<()> {
+    let started = Instant::now();
+    let input = Input::open(&args.io.input)?;
+    let (t, pts) = read_points(&input, args.machine.as_deref())?;
+    let opts = Options {
+        max_amplification: positive(args.max_amplification, "--max-amplification")?,
+        robust: match args.robust {
+            RobustArg::None => Robust::None,
+            RobustArg::Huber => Robust::Huber(positive(args.huber_k, "--huber-k")?),
+        },
+    };
+    let truth = args.truth.as_deref().map(read_shape).transpose()?;
+    let kind = args.shape.kind();
+    let fit_started = Instant::now();
+    let result = surf_probe_fit::fit(kind, &pts, &opts);
+    let fit_seconds = fit_started.elapsed().as_secs_f64();
+    let f = result.map_err(|e| match e {
+        FitError::Undetermined(m) => Error::input(m).at(Location::file(&input.name)),
+        FitError::NotConverged(m) => Error::check(format!("{}: {m}", input.name)),
+    })?;
+    if let Some(w) = f.warning() {
+        cli::warn(&w);
+    }
+    let doc =
+        frame::frame_of(&f, format!("surf-probe-fit: {} fit of {} points from {}", kind.name(), pts.len(), input.name));
+    let mut out = Output::new(args.io.output.as_deref());
+    out.buf = serde_json::to_vec_pretty(&doc).map_err(|e| Error::runtime(e.to_string()))?;
+    out.buf.push(b'\n');
+    let mut report = Report::new("surf-probe-fit");
+    report
+        .set("command", "fit")
+        .set("shape", kind.name())
+        .set("points", pts.len())
+        .set("rows", t.rows.len())
+        .set("rms_mm", f.rms)
+        .set("largest_residual_mm", f.largest_residual)
+        .set("largest_residual_line", t.rows[f.largest_residual_index].line)
+        .set("iterations", f.iterations)
+        .set("parameters", &f.parameters)
+        .set("poorly_determined", &f.poorly_determined)
+        .set("frame", [doc.xc, doc.yc, doc.za]);
+    if let Some(truth) = &truth {
+        truth_keys(&mut report, &f.shape, truth);
+    }
+    report.set("fit_seconds", fit_seconds).set("seconds", started.elapsed().as_secs_f64());
+    if let Some(path) = &args.io.report {
+        report.write(path)?;
+    }
+    out.commit()
+}
+
+/// Errors of the fitted element against the true one, in the report.
+fn truth_keys(report: &mut Report, got: &Shape, truth: &Shape) {
+    let origin_error = (frame::origin(got) - frame::origin(truth)).norm();
+    report.set("origin_error_mm", origin_error);
+    let radius = |s: &Shape| match s {
+        Shape::Sphere { radius, .. } | Shape::Circle { radius, .. } | Shape::Cylinder { radius, .. } => Some(*radius),
+        Shape::Plane { .. } => None,
+    };
+    if let (Some(a), Some(b)) = (radius(got), radius(truth)) {
+        report.set("radius_error_mm", a - b);
+    }
+}
+
+fn pose_table(extra: &[&str]) -> Table {
+    let mut t = Table {
+        schema: Schema::of(&[Col::Path, Col::Move, Col::X, Col::Y, Col::Z, Col::I, Col::J, Col::K, Col::Tag]),
+        rows: Vec::new(),
+    };
+    for name in extra {
+        t.add_extra_column(name);
+    }
+    t
+}
+
+fn write_table(t: &Table, out: &OutArgs, report: &Report) -> Result<()> {
+    let mut o = Output::new(out.output.as_deref());
+    table::write(&mut o, t, &WriteOptions::default())?;
+    if let Some(path) = &out.report {
+        report.write(path)?;
+    }
+    o.commit()
+}
+
+fn run_raster(args: RasterArgs) -> Result<()> {
+    let step = positive(args.step, "--step")?;
+    if args.x.len() != 2 || args.y.len() != 2 {
+        return Err(Error::input("--x and --y take two numbers: MIN,MAX"));
+    }
+    let (x0, x1, y0, y1) = (args.x[0], args.x[1], args.y[0], args.y[1]);
+    if !(x0 < x1 && y0 < y1 && args.z.is_finite()) {
+        return Err(Error::input("--x and --y must be ranges MIN,MAX with MIN < MAX, --z a number"));
+    }
+    let (nx, ny) = (((x1 - x0) / step).floor() as usize, ((y1 - y0) / step).floor() as usize);
+    if (nx + 1) * (ny + 1) > 10_000_000 {
+        return Err(Error::input("the raster would have more than 10 million poses: use a larger --step"));
+    }
+    let mut t = pose_table(&[]);
+    for j in 0..=ny {
+        let y = y0 + j as f64 * step;
+        for k in 0..=nx {
+            let i = if j % 2 == 0 { k } else { nx - k };
+            let mut row = Row::at(j as i64, P3::new(x0 + i as f64 * step, y, args.z));
+            row.mv = if k == 0 { Move::Rapid } else { Move::Line };
+            row.tag = "raster".into();
+            t.rows.push(row);
+        }
+    }
+    let mut report = Report::new("surf-probe-fit");
+    report.set("command", "raster").set("poses", t.rows.len()).set("lines", ny + 1);
+    write_table(&t, &args.out, &report)
+}
+
+fn run_simulate(args: SimulateArgs) -> Result<()> {
+    let shape = read_shape(&args.shape)?;
+    let s = &args.sensor;
+    let sensor = Sensor {
+        standoff: positive(s.standoff, "--standoff")?,
+        range: positive(s.range, "--range")?,
+        noise: if s.noise >= 0.0 { s.noise } else { return Err(Error::input("--noise must not be negative")) },
+        slope_error: s.slope_error,
+        max_incidence: positive(s.max_incidence, "--max-incidence")?.min(90.0),
+    };
+    let input = Input::open(&args.io.input)?;
+    let t = table::read(&input, &[Col::X, Col::Y])?;
+    let (chain, cone) = table_chain(args.machine.as_deref())?;
+    let poses: Vec<(P3, V3)> = t.rows.iter().map(|r| (r.pos, r.axis.normalize())).collect();
+    let joints = records::joints_for(&chain, &poses, cone).map_err(|(i, e)| {
+        Error::input(format!("pose cannot be reached: {}", e.0)).at(Location::file(&input.name).line(t.rows[i].line))
+    })?;
+    let rotaries: Vec<String> = chain.rotaries().iter().map(|r| r.address.to_ascii_lowercase().to_string()).collect();
+    let mut names: Vec<&str> = rotaries.iter().map(String::as_str).collect();
+    names.extend(["reading", "incidence"]);
+    let mut out_t = Table { schema: Schema::of(&[Col::Path, Col::X, Col::Y, Col::Z]), rows: Vec::new() };
+    for n in &names {
+        out_t.add_extra_column(n);
+    }
+    let mut rng = Rng::new(args.seed);
+    let (mut lost, mut worst) = (0usize, 0.0f64);
+    for ((row, (tip, axis)), j) in t.rows.iter().zip(&poses).zip(&joints) {
+        let Some(r) = sensor.read(&shape, tip, axis, &mut rng) else {
+            lost += 1;
+            continue;
+        };
+        worst = worst.max(r.incidence);
+        let mut rec = Row::at(row.path, P3::from(j.xyz));
+        rec.extra = j.rot[..rotaries.len()].iter().map(|a| a.to_string()).collect();
+        rec.extra.push(r.value.to_string());
+        rec.extra.push(format!("{:.3}", r.incidence));
+        out_t.rows.push(rec);
+    }
+    if out_t.rows.is_empty() {
+        return Err(Error::input("no pose returned a reading: the beam misses the element or is out of range")
+            .at(Location::file(&input.name)));
+    }
+    if lost > 0 {
+        cli::warn(&format!(
+            "{lost} of {} poses returned no reading (missed, out of range or too oblique)",
+            t.rows.len()
+        ));
+    }
+    let mut report = Report::new("surf-probe-fit");
+    report
+        .set("command", "simulate")
+        .set("poses", t.rows.len())
+        .set("readings", out_t.rows.len())
+        .set("lost", lost)
+        .set("largest_incidence_deg", worst);
+    write_table(&out_t, &OutArgs { output: args.io.output, report: args.io.report }, &report)
+}
+
+fn run_points(args: PointsArgs) -> Result<()> {
+    let input = Input::open(&args.io.input)?;
+    let t = table::read(&input, &[Col::X, Col::Y])?;
+    let (chain, _) = table_chain(args.machine.as_deref())?;
+    let recs = read_records(&t, &chain, &input.name)?;
+    let mut out = Table { schema: Schema::of(&[Col::Path, Col::X, Col::Y, Col::Z]), rows: Vec::new() };
+    for (row, r) in t.rows.iter().zip(&recs) {
+        out.rows.push(Row::at(row.path, records::to_point(&chain, r)));
+    }
+    let mut report = Report::new("surf-probe-fit");
+    report.set("command", "points").set("points", out.rows.len());
+    write_table(&out, &OutArgs { output: args.io.output, report: args.io.report }, &report)
+}
+
+fn run_plan(args: PlanArgs) -> Result<()> {
+    let standoff = positive(args.standoff, "--standoff")?;
+    let mut report = Report::new("surf-probe-fit");
+    report.set("command", "plan");
+    let probes: Vec<Probe> = if let Some(path) = &args.fit {
+        let Shape::Sphere { centre, radius } = read_shape(path)? else {
+            return Err(Error::input("--fit must hold a sphere").at(Location::file(path)));
+        };
+        positive(args.ring_step, "--ring-step")?;
+        report.set("from", "sphere");
+        rough::plan_on_sphere(&P3::from(centre), radius, args.max_polar.clamp(0.0, 180.0), args.ring_step)
+    } else {
+        let input = Input::open(&args.io.input)?;
+        let t = table::read(&input, &[Col::X, Col::Y])?;
+        let pts: Vec<P3> = t.rows.iter().map(|r| r.pos).collect();
+        let paths: Vec<i64> = t.rows.iter().map(|r| r.path).collect();
+        let surface =
+            rough::triangulate(&pts, args.max_slope).map_err(|m| Error::input(m).at(Location::file(&input.name)))?;
+        report.set("from", "rough surface").set("points", pts.len()).set("facets", surface.facets.len());
+        rough::plan_from_surface(&pts, &paths, &surface, args.every)
+    };
+    let mut t = pose_table(&[]);
+    t.schema.add(&[Col::Px, Col::Py, Col::Pz, Col::Nx, Col::Ny, Col::Nz]);
+    // Each pose is its own pass, positioned by a rapid move: the sensor reads standing still, and
+    // poses on either side of the top would otherwise make the table swing through C's singularity.
+    for (k, p) in probes.iter().enumerate() {
+        let mut row = Row::at(k as i64, p.tip(standoff));
+        row.mv = Move::Rapid;
+        row.axis = p.normal;
+        row.contact = Some(p.point);
+        row.normal = Some(p.normal);
+        row.tag = "probe".into();
+        t.rows.push(row);
+    }
+    let tilt = probes.iter().map(|p| p.normal.z.clamp(-1.0, 1.0).acos().to_degrees()).fold(0.0, f64::max);
+    report.set("probes", probes.len()).set("largest_tilt_deg", tilt).set("standoff_mm", standoff);
+    write_table(&t, &OutArgs { output: args.io.output, report: args.io.report }, &report)
+}
+
+fn run_reference(args: ReferenceArgs) -> Result<()> {
+    if args.centre.len() != 3 || args.axis.len() != 3 {
+        return Err(Error::input("--centre and --axis take three numbers: X,Y,Z"));
+    }
+    let c = [args.centre[0], args.centre[1], args.centre[2]];
+    let a = V3::new(args.axis[0], args.axis[1], args.axis[2]);
+    if a.norm().is_nan() || a.norm() == 0.0 {
+        return Err(Error::input("--axis must be a non-zero vector"));
+    }
+    let a: [f64; 3] = a.normalize().into();
+    let r = positive(args.radius, "--radius")?;
+    let shape = match args.shape {
+        ShapeArg::Sphere => Shape::Sphere { centre: c, radius: r },
+        ShapeArg::Plane => Shape::Plane { point: c, normal: a },
+        ShapeArg::Circle => Shape::Circle { centre: c, normal: a, radius: r },
+        ShapeArg::Cylinder => Shape::Cylinder { point: c, axis: a, radius: r },
+    };
+    let kind = args.shape.kind();
+    if args.points < kind.parameters() + 1 {
+        return Err(Error::input(format!("--points must be at least {}", kind.parameters() + 1)));
+    }
+    let set = reference::generate(&Spec {
+        shape: shape.clone(),
+        points: args.points,
+        amplitude: args.amplitude,
+        extent: positive(args.extent, "--extent")?,
+        seed: args.seed,
+    });
+    let mut t = Table { schema: Schema::of(&[Col::X, Col::Y, Col::Z]), rows: Vec::new() };
+    t.rows.extend(set.points.iter().map(|p| Row::at(0, *p)));
+    let mut report = Report::new("surf-probe-fit");
+    report.set("command", "reference").set("truth", &shape).set("points", set.points.len());
+    write_table(&t, &args.out, &report)
+}

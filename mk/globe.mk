@@ -1,0 +1,50 @@
+# globe (paper 002): a sphere on the A/C table measured on the machine by a simulated laser sensor —
+# a 3-axis raster, its rough Delaunay surface, a 5-axis plan along the surface normals (posted to NC),
+# the 5-axis measurement — and fitted: the workpiece frame for post-6axis, with the 3-axis and
+# 5-axis fit errors against the true sphere side by side (summary.txt).
+DEMOS += globe
+FILTERS += surf-probe-fit post-6axis
+GLOBE := $(OUT)/globe
+GLOBE_TRUE ?= data/surf-probe-fit/globe-true.json
+GLOBE_MACHINE ?= data/post-6axis/paper002-ac.json
+GLOBE_X ?= -28,34
+GLOBE_Y ?= -31,29
+GLOBE_STEP ?= 2
+GLOBE_Z ?= 115.5
+GLOBE_EVERY ?= 5
+GLOBE_STANDOFF ?= 50
+GLOBE_SEED ?= 1
+
+.PHONY: demo-globe
+demo-globe: $(GLOBE)/summary.txt $(GLOBE)/plan.ngc
+
+$(GLOBE)/raster.csv: mk/globe.mk $(RELEASE)/surf-probe-fit | $(GLOBE)/
+	$(RELEASE)/surf-probe-fit raster --x $(GLOBE_X) --y $(GLOBE_Y) --step $(GLOBE_STEP) --z $(GLOBE_Z) -o $@
+
+$(GLOBE)/raster-records.csv: $(GLOBE)/raster.csv $(GLOBE_TRUE) $(RELEASE)/surf-probe-fit
+	$(RELEASE)/surf-probe-fit simulate $< --shape $(GLOBE_TRUE) --standoff $(GLOBE_STANDOFF) --seed $(GLOBE_SEED) --report $(GLOBE)/raster-records.json -o $@
+
+$(GLOBE)/raster-points.csv: $(GLOBE)/raster-records.csv $(RELEASE)/surf-probe-fit
+	$(RELEASE)/surf-probe-fit points $< -o $@
+
+$(GLOBE)/fit-3axis.json: $(GLOBE)/raster-points.csv $(GLOBE_TRUE) $(RELEASE)/surf-probe-fit
+	$(RELEASE)/surf-probe-fit fit $< --truth $(GLOBE_TRUE) --report $(GLOBE)/fit-3axis-report.json -o $@
+
+$(GLOBE)/plan.csv: $(GLOBE)/raster-points.csv $(RELEASE)/surf-probe-fit
+	$(RELEASE)/surf-probe-fit plan $< --every $(GLOBE_EVERY) --standoff $(GLOBE_STANDOFF) --report $(GLOBE)/plan.json -o $@
+
+$(GLOBE)/plan.ngc: $(GLOBE)/plan.csv $(GLOBE_MACHINE) $(RELEASE)/post-6axis
+	$(RELEASE)/post-6axis $< --machine $(GLOBE_MACHINE) --frame data/surf-probe-fit/table-frame.json --feed 2000 --report $(GLOBE)/plan-post.json -o $@
+
+$(GLOBE)/records-5axis.csv: $(GLOBE)/plan.csv $(GLOBE_TRUE) $(GLOBE_MACHINE) $(RELEASE)/surf-probe-fit
+	$(RELEASE)/surf-probe-fit simulate $< --machine $(GLOBE_MACHINE) --shape $(GLOBE_TRUE) --standoff $(GLOBE_STANDOFF) --seed $(GLOBE_SEED) --report $(GLOBE)/records-5axis.json -o $@
+
+$(GLOBE)/frame.json: $(GLOBE)/records-5axis.csv $(GLOBE_TRUE) $(GLOBE_MACHINE) $(RELEASE)/surf-probe-fit
+	$(RELEASE)/surf-probe-fit fit $< --machine $(GLOBE_MACHINE) --truth $(GLOBE_TRUE) --report $(GLOBE)/frame-report.json -o $@
+
+$(GLOBE)/summary.txt: $(GLOBE)/fit-3axis.json $(GLOBE)/frame.json
+	for m in 3axis 5axis; do \
+	  r=$(GLOBE)/fit-3axis-report.json; [ $$m = 5axis ] && r=$(GLOBE)/frame-report.json; \
+	  printf '%s fit: ' $$m; grep -E '"(points|rms_mm|origin_error_mm|radius_error_mm)"' $$r | tr -d ' \n'; echo; \
+	done > $@
+	cat $@

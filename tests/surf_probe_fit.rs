@@ -1,0 +1,159 @@
+//! End-to-end tests of `surf-probe-fit`: the globe measurement (3-axis raster, rough Delaunay
+//! surface, 5-axis plan along its normals on paper 002's A/C machine, simulated sensor, fit)
+//! with the 5-axis fit beating the 3-axis one against the known sphere; the plan and the frame
+//! accepted by `post-6axis`; reference sets reproduced through CSV; bad input refused with one
+//! line and no output file.
+
+use e2e::{Work, data};
+
+const BIN: &str = "surf-probe-fit";
+
+fn json(w: &Work, name: &str) -> serde_json::Value {
+    serde_json::from_str(&w.read(name)).expect("JSON")
+}
+
+fn d(rel: &str) -> String {
+    data(rel).to_str().unwrap().to_string()
+}
+
+#[test]
+fn globe_five_axis_along_normals_beats_three_axis() {
+    let w = Work::new();
+    let truth = d("surf-probe-fit/globe-true.json");
+    let machine = d("post-6axis/paper002-ac.json");
+    w.run(BIN, &["raster", "--x", "-28,34", "--y", "-31,29", "--step", "2", "--z", "115.5", "-o", "raster.csv"], b"")
+        .ok();
+    w.run(BIN, &["simulate", "raster.csv", "--shape", &truth, "-o", "rec3.csv"], b"").ok();
+    w.run(BIN, &["points", "rec3.csv", "-o", "pts3.csv"], b"").ok();
+    w.run(BIN, &["fit", "pts3.csv", "--truth", &truth, "-o", "fit3.json", "--report", "r3.json"], b"").ok();
+    w.run(BIN, &["plan", "pts3.csv", "--every", "5", "-o", "plan.csv", "--report", "plan.json"], b"").ok();
+    let plan = json(&w, "plan.json");
+    assert!(plan["probes"].as_u64().unwrap() > 50 && plan["largest_tilt_deg"].as_f64().unwrap() > 60.0, "{plan}");
+    w.run(
+        BIN,
+        &["simulate", "plan.csv", "-m", &machine, "--shape", &truth, "-o", "rec5.csv", "--report", "s5.json"],
+        b"",
+    )
+    .ok();
+    let s5 = json(&w, "s5.json");
+    assert_eq!(s5["lost"], 0, "{s5}");
+    assert!(s5["largest_incidence_deg"].as_f64().unwrap() < 10.0, "{s5}");
+    assert!(w.read("rec5.csv").starts_with("path,x,y,z,c,a,reading"));
+    w.run(BIN, &["fit", "rec5.csv", "-m", &machine, "--truth", &truth, "-o", "fit5.json", "--report", "r5.json"], b"")
+        .ok();
+    let (r3, r5) = (json(&w, "r3.json"), json(&w, "r5.json"));
+    let e3 = r3["origin_error_mm"].as_f64().unwrap().max(r3["radius_error_mm"].as_f64().unwrap().abs());
+    let e5 = r5["origin_error_mm"].as_f64().unwrap().max(r5["radius_error_mm"].as_f64().unwrap().abs());
+    assert!(e5 < 0.002 && e3 > 5.0 * e5, "3-axis {e3} mm, 5-axis {e5} mm");
+    // The frame puts the workpiece origin at the fitted centre.
+    let f = json(&w, "fit5.json");
+    let c = &f["fit"]["centre"];
+    for (k, name) in ["xc", "yc", "za"].iter().enumerate() {
+        assert_eq!(f[name].as_f64().unwrap(), -c[k].as_f64().unwrap());
+    }
+}
+
+#[test]
+fn post_6axis_accepts_the_plan_and_the_frame() {
+    let w = Work::new();
+    let truth = d("surf-probe-fit/globe-true.json");
+    let machine = d("post-6axis/paper002-ac.json");
+    w.run(BIN, &["plan", "--fit", &truth, "--ring-step", "20", "--max-polar", "60", "-o", "plan.csv"], b"").ok();
+    w.run(
+        "post-6axis",
+        &[
+            "plan.csv",
+            "-m",
+            &machine,
+            "--frame",
+            &d("surf-probe-fit/table-frame.json"),
+            "--feed",
+            "500",
+            "-o",
+            "plan.ngc",
+        ],
+        b"",
+    )
+    .ok();
+    assert!(w.read("plan.ngc").contains(" A"), "a 5-axis program");
+    w.run(BIN, &["reference", "--centre", "3.2,-1.7,40.5", "--extent", "60", "--points", "200", "-o", "pts.csv"], b"")
+        .ok();
+    w.run(BIN, &["fit", "pts.csv", "-o", "frame.json"], b"").ok();
+    w.write("cl.csv", "path,move,x,y,z,i,j,k\n0,rapid,0,0,30,0,0,1\n0,line,0,10,30,0,0.6,0.8\n");
+    w.run("post-6axis", &["cl.csv", "-m", &machine, "--frame", "frame.json", "--feed", "300", "-o", "cut.ngc"], b"")
+        .ok();
+    assert!(w.exists("cut.ngc"));
+}
+
+#[test]
+fn reference_sets_are_reproduced_through_csv() {
+    let w = Work::new();
+    for (shape, extra) in [
+        ("sphere", vec!["--centre", "1200,-850,640", "--extent", "30"]),
+        ("cylinder", vec!["--centre", "-40,7,3", "--axis", "0.1,0.95,0.3", "--radius", "12.5", "--extent", "60"]),
+        ("plane", vec!["--centre", "10,20,30", "--axis", "0.3,-0.2,0.9", "--extent", "40"]),
+        ("circle", vec!["--centre", "5,-3,12", "--axis", "0.3,-0.2,0.9", "--radius", "18", "--extent", "360"]),
+    ] {
+        let mut args = vec!["reference", "--shape", shape, "--points", "300", "-o", "pts.csv", "--report", "ref.json"];
+        args.extend(extra);
+        w.run(BIN, &args, b"").ok();
+        w.run(BIN, &["fit", "pts.csv", "--shape", shape, "-o", "fit.json"], b"").ok();
+        let (truth, fit) = (json(&w, "ref.json")["truth"].clone(), json(&w, "fit.json")["fit"].clone());
+        let v = |j: &serde_json::Value, k: &str| -> Vec<f64> {
+            match &j[k] {
+                serde_json::Value::Array(a) => a.iter().map(|x| x.as_f64().unwrap()).collect(),
+                x => vec![x.as_f64().unwrap()],
+            }
+        };
+        let keys: &[&str] = match shape {
+            "sphere" => &["centre", "radius"],
+            "circle" => &["centre", "normal", "radius"],
+            "cylinder" => &["radius"],
+            _ => &["normal"],
+        };
+        for k in keys {
+            for (a, b) in v(&truth, k).iter().zip(v(&fit, k)) {
+                assert!((a - b).abs() < 1e-7, "{shape} {k}: {a} vs {b}");
+            }
+        }
+    }
+}
+
+#[test]
+fn small_cap_warns_about_the_radius() {
+    let w = Work::new();
+    w.run(BIN, &["reference", "--extent", "5", "--points", "300", "-o", "cap.csv"], b"").ok();
+    let o = w.run(BIN, &["fit", "cap.csv", "-o", "fit.json"], b"");
+    o.ok();
+    assert!(o.stderr.contains("warning") && o.stderr.contains("radius"), "{}", o.stderr);
+    assert!(json(&w, "fit.json")["fit"]["poorly_determined"].as_array().unwrap().iter().any(|p| p == "radius"));
+}
+
+#[test]
+fn bad_input_is_refused() {
+    let w = Work::new();
+    w.write("three.csv", "x,y,z\n0,0,0\n1,0,0\n0,1,1\n");
+    w.run(BIN, &["fit", "three.csv", "-o", "out.json"], b"").fails(2, "3 points: a sphere needs at least 4");
+    let flat: String =
+        (0..12).map(|k| format!("{},{},5\n", (k as f64).cos() * 10.0, (k as f64).sin() * 10.0)).collect();
+    w.write("flat.csv", format!("x,y,z\n{flat}"));
+    w.run(BIN, &["fit", "flat.csv", "-o", "out.json"], b"").fails(2, "all points lie on one plane");
+    w.write("nan.csv", "x,y,z\n0,0,0\n1,0,NaN\n");
+    w.run(BIN, &["fit", "nan.csv", "-o", "out.json"], b"").fails(2, "nan.csv:3");
+    w.write("dup.csv", "x,y,z\n0,0,1\n1,0,0\n0,1,0\n-1,0,0\n1,0,0\n");
+    w.run(BIN, &["fit", "dup.csv", "-o", "out.json"], b"").fails(2, "duplicate point: the same as line 3");
+    w.write("rec.csv", "x,y,z,reading\n0,0,10,abc\n");
+    w.run(BIN, &["fit", "rec.csv", "-o", "out.json"], b"").fails(2, "rec.csv:2:4 (reading)");
+    // Nearly on a plane (a 1 µm bulge over 20 mm): the radius runs off, a failed fit (exit 1).
+    let bulge: String = (0..40)
+        .map(|k| {
+            let (x, y) = ((k % 7) as f64 * 3.0, (k / 7) as f64 * 3.0);
+            format!("{x},{y},{}\n", 1e-6 * ((x * x + y * y) / 400.0))
+        })
+        .collect();
+    w.write("bulge.csv", format!("x,y,z\n{bulge}"));
+    let o = w.run(BIN, &["fit", "bulge.csv", "-o", "out.json"], b"");
+    assert_eq!(o.status, 1, "{}", o.stderr);
+    assert_eq!(o.stderr.trim_end().lines().count(), 1, "{}", o.stderr);
+    assert!(!w.exists("out.json"), "no partial output");
+}
