@@ -128,18 +128,13 @@ impl Machine<'_> {
         self.solver.chain
     }
 
-    /// Controller linear values for a tip at rotary angles.
-    fn linear(&self, tip: &P3, rot: &[f64; 2], tcp: bool) -> V3 {
-        if tcp { tip.coords } else { self.chain().linear_for(tip, rot) }
+    /// Controller linear values for a tip at rotary angles, and the tool frame orientation there.
+    fn linear(&self, tip: &P3, rot: &[f64; 2], tcp: bool) -> (V3, M3) {
+        if tcp { (tip.coords, self.chain().orientation(rot)) } else { self.chain().linear_oriented(tip, rot) }
     }
 
-    /// Controller spindle angle for CL orientation `s` at rotary angles `rot`, near `prev`.
-    fn spindle(&self, rot: &[f64; 2], s: Option<f64>, prev: Option<f64>) -> Option<f64> {
-        self.spindle?;
-        self.spindle_in(&self.chain().orientation(rot), s, prev)
-    }
-
-    /// [`Machine::spindle`] for a tool frame orientation already known.
+    /// Controller spindle angle for CL orientation `s` with the tool frame at orientation `frame`,
+    /// near `prev`.
     fn spindle_in(&self, frame: &M3, s: Option<f64>, prev: Option<f64>) -> Option<f64> {
         let sp = self.spindle?;
         let s = s?;
@@ -190,18 +185,19 @@ pub fn point_segment(p: &P3, a: &P3, b: &P3) -> f64 {
 pub fn vector_arc(v: &V3, a: &V3, b: &V3) -> f64 {
     let n = a.cross(b);
     let nn = n.norm();
-    let ends = angle_between(v, a).min(angle_between(v, b));
+    // The angle to the nearer end, computed only where needed (a hot path of the post).
+    let ends = || angle_between(v, a).min(angle_between(v, b));
     if nn < 1e-15 {
-        return ends;
+        return ends();
     }
     let n = n / nn;
     // Project onto the arc's plane; inside the arc's wedge the distance is the angle to the plane.
     let p = v - n * n.dot(v);
     if p.norm() < 1e-15 {
-        return ends;
+        return ends();
     }
     let inside = a.cross(&p).dot(&n) >= 0.0 && p.cross(b).dot(&n) >= 0.0;
-    if inside { n.dot(v).abs().asin() } else { ends }
+    if inside { n.dot(v).abs().asin() } else { ends() }
 }
 
 /// Spherical linear interpolation between unit vectors.
@@ -250,13 +246,13 @@ fn poses(rows: &[Cl], m: &Machine, opts: &Options, stats: &mut Stats) -> Result<
     let mut steps = Vec::with_capacity(rows.len());
     let mut sigma: Option<f64> = None;
     for (i, (row, c)) in rows.iter().zip(&choices).enumerate() {
-        let xyz = m.linear(&row.tip, &c.rot, opts.tcp);
+        let (xyz, frame) = m.linear(&row.tip, &c.rot, opts.tcp);
         m.check_travel(&xyz).map_err(|message| PlanError { row: i, message, unreachable: true })?;
         let joints = Joints { xyz, rot: c.rot };
-        sigma = m.spindle(&c.rot, row.s, sigma).or(sigma);
+        sigma = m.spindle_in(&frame, row.s, sigma).or(sigma);
         if c.singular {
             stats.singular_rows += 1;
-            let axis = chain.orientation(&c.rot).column(2).into_owned();
+            let axis = frame.column(2).into_owned();
             stats.pose_axis_error = stats.pose_axis_error.max(angle_between(&axis, &row.axis));
         }
         steps.push(Step {
@@ -404,9 +400,9 @@ fn inserted(m: &Machine, opts: &Options, a: &Step, b: &Step, t: f64) -> Result<S
         m.solver.choose(&axis, &a.joints.rot)
     }
     .map_err(|e| PlanError { row: b.row, message: e.0, unreachable: true })?;
-    let xyz = m.linear(&tip, &c.rot, opts.tcp);
+    let (xyz, frame) = m.linear(&tip, &c.rot, opts.tcp);
     m.check_travel(&xyz).map_err(|message| PlanError { row: b.row, message, unreachable: true })?;
-    let spindle = m.spindle(&c.rot, s, a.spindle).filter(|_| s.is_some());
+    let spindle = m.spindle_in(&frame, s, a.spindle).filter(|_| s.is_some());
     Ok(Step { joints: Joints { xyz, rot: c.rot }, spindle, cl, row: b.row, inserted: true, singular })
 }
 

@@ -351,6 +351,14 @@ impl Chain {
         r.transpose() * (tip.coords - t) - h
     }
 
+    /// [`Chain::linear_for`] and the tool frame orientation ([`Chain::orientation`]) at `rot`, from
+    /// one evaluation of the rotations (for callers that need both, e.g. with a spindle angle).
+    pub fn linear_oriented(&self, tip: &P3, rot: &[f64; 2]) -> (V3, M3) {
+        let rots = self.rotations(rot);
+        let (r, t, h) = self.sides(&rots);
+        (r.transpose() * (tip.coords - t) - h, self.orientation_of(&rots))
+    }
+
     /// Rotary angles that turn the tool axis onto `axis` (unit), both branches, principal values.
     /// `None` if no angles reach it (a machine with fewer than two rotary axes, or an axis
     /// outside the reachable cone of a non-orthogonal head).
