@@ -65,6 +65,8 @@ pub struct Analysed {
     pub max_cutting: f64,
     /// Largest engagement over links.
     pub max_link: f64,
+    /// Samples of cutting moves (trochoids and passes) over the threshold.
+    pub over: usize,
     /// Largest engagement over entries.
     pub max_entry: f64,
     /// Machining time of the layer (min) with the feed following the engagement sample by sample.
@@ -97,6 +99,10 @@ pub struct Plan {
     /// Samples of the offset-only program over the threshold.
     pub danger_samples: usize,
 }
+
+/// Round-off of a computed engagement (degrees): a side cut at exactly the threshold's step
+/// over computes to the threshold within this.
+pub const ENGAGEMENT_ROUNDOFF_DEG: f64 = 1e-6;
 
 /// How many loop radii a plan tries: the given one and its halvings.
 const LEVELS: usize = 5;
@@ -152,6 +158,13 @@ pub fn analyse(program: Program, s: &Settings, regions: &[Region]) -> Analysed {
     }
     let get = |t: Tag| worst.get(&t).copied().unwrap_or(0.0);
     let max_cutting = get(Tag::Trochoid).max(get(Tag::Contour));
+    let over = samples
+        .iter()
+        .zip(&engagement)
+        .filter(|((i, _), e)| {
+            matches!(program.moves[*i].tag, Tag::Trochoid | Tag::Contour) && **e > s.threshold + ENGAGEMENT_ROUNDOFF_DEG
+        })
+        .count();
     // Two feed strategies: every sample at the feed its own engagement allows (the larger of
     // the engagements at its two ends; air at the tool's largest feed per tooth), and each kind
     // of move at one feed, the one its worst engagement allows. Entries ramp at the slot feed.
@@ -183,6 +196,7 @@ pub fn analyse(program: Program, s: &Settings, regions: &[Region]) -> Analysed {
         feeds,
         max_cutting,
         max_link: get(Tag::Link),
+        over,
         max_entry: get(Tag::Entry),
         minutes,
         minutes_constant,
@@ -220,7 +234,7 @@ pub fn plan(regions: &[Region], s: &Settings) -> Result<Plan, PlanError> {
         .samples
         .iter()
         .zip(&offset_only.engagement)
-        .filter(|(_, e)| **e > s.threshold)
+        .filter(|(_, e)| **e > s.threshold + ENGAGEMENT_ROUNDOFF_DEG)
         .map(|(&(i, t), _)| offset_only.program.moves[i].seg.point_at(t))
         .collect();
     let reach = s.step.max(s.sample);

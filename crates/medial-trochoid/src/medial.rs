@@ -11,7 +11,8 @@
 use boostvoronoi::{Builder, Line, Point, SourceCategory};
 use camkit::contour::Seg;
 use camkit::contour::region::Region;
-use camkit::geom::{P2, V2};
+use camkit::geom::{P2, V2, cross2};
+use std::time::Instant;
 
 /// `1 − cos` of the largest turn between two pieces that still counts as smooth (about 0.1°).
 const SMOOTH: f64 = 2e-6;
@@ -49,6 +50,8 @@ pub struct Medial {
     pub edges: Vec<MedialEdge>,
     /// Boundary segments given to the Voronoi builder.
     pub segments: usize,
+    /// Time the Voronoi builder took (s).
+    pub build_seconds: f64,
     /// Largest distance from a kept point to its two nearest sites' mean (mm): how equidistant
     /// the edges are (0 up to round-off on the snapped boundary).
     pub equidistance_error: f64,
@@ -76,6 +79,10 @@ impl std::fmt::Display for MedialError {
 struct Site {
     a: P2,
     b: P2,
+    /// Turn at `a` and at `b` (cross product of the pieces in and out; negative at a reflex
+    /// vertex, material being on the left).
+    turn_a: f64,
+    turn_b: f64,
 }
 
 /// The medial axis of `region`.
@@ -120,15 +127,28 @@ pub fn medial_axis(region: &Region, opts: &MedialOptions) -> Result<Medial, Medi
         while ring.len() > 1 && ring[0].0 == ring[ring.len() - 1].0 {
             ring.pop();
         }
+        let n = ring.len();
+        let turn = |k: usize| {
+            let (p, q, r) = (ring[(k + n - 1) % n].0, ring[k].0, ring[(k + 1) % n].0);
+            let (ux, uy) = (f64::from(q.0) - f64::from(p.0), f64::from(q.1) - f64::from(p.1));
+            let (vx, vy) = (f64::from(r.0) - f64::from(q.0), f64::from(r.1) - f64::from(q.1));
+            ux * vy - uy * vx
+        };
         for k in 0..ring.len() {
             let (a, b) = (ring[k].0, ring[(k + 1) % ring.len()].0);
             lines.push(Line::new(Point { x: a.0, y: a.1 }, Point { x: b.0, y: b.1 }));
             if ring[k].1 {
                 joints.insert((i64::from(ring[k].0.0), i64::from(ring[k].0.1)));
             }
-            sites.push(Site { a: unsnap(f64::from(a.0), f64::from(a.1)), b: unsnap(f64::from(b.0), f64::from(b.1)) });
+            sites.push(Site {
+                a: unsnap(f64::from(a.0), f64::from(a.1)),
+                b: unsnap(f64::from(b.0), f64::from(b.1)),
+                turn_a: turn(k),
+                turn_b: turn((k + 1) % n),
+            });
         }
     }
+    let started = Instant::now();
     let diagram = Builder::<i32, f64>::default()
         .with_segments(lines.iter().copied())
         .and_then(|b| b.build())
@@ -138,7 +158,7 @@ pub fn medial_axis(region: &Region, opts: &MedialOptions) -> Result<Medial, Medi
         let c = diagram.get_cell(cell).ok()?.get();
         Some((c.source_index(), c.source_category()))
     };
-    let mut out = Medial { segments: sites.len(), ..Medial::default() };
+    let mut out = Medial { segments: sites.len(), build_seconds: started.elapsed().as_secs_f64(), ..Medial::default() };
     for e in diagram.edges() {
         let e = e.get();
         let id = e.id();
@@ -167,7 +187,18 @@ pub fn medial_axis(region: &Region, opts: &MedialOptions) -> Result<Medial, Medi
         };
         let mid = points[points.len() / 2].coords.lerp(&points[(points.len() - 1) / 2].coords, 0.5);
         let probe = if points.len() == 2 { P2::from((p0.coords + p1.coords) * 0.5) } else { P2::from(mid) };
-        if !region.contains(&probe) {
+        // Inside the material: left of a segment site (boundaries run counter-clockwise,
+        // islands clockwise); between two point sites, by winding number.
+        let inside = match (geo0, geo1) {
+            (Geo::Seg(a, b), _) | (_, Geo::Seg(a, b)) => cross2(&(b - a), &(probe - a)) > 0.0,
+            // Two vertices: their cells lie inside at reflex vertices, outside at convex ones.
+            _ => match (turn_of(&sites, s0), turn_of(&sites, s1)) {
+                (a, b) if a < 0.0 && b < 0.0 => true,
+                (a, b) if a > 0.0 || b > 0.0 => false,
+                _ => region.contains(&probe),
+            },
+        };
+        if !inside {
             continue;
         }
         let clearance: Vec<f64> = points.iter().map(|p| geo0.distance(p)).collect();
@@ -191,6 +222,15 @@ impl Geo {
             Geo::Point(q) => (p - q).norm(),
             Geo::Seg(a, b) => camkit::geom::dist::point_segment(p, a, b),
         }
+    }
+}
+
+/// Turn at the vertex a point site stands for (0 for a segment site).
+fn turn_of(sites: &[Site], (i, cat): (usize, SourceCategory)) -> f64 {
+    match cat {
+        SourceCategory::SegmentStart | SourceCategory::SinglePoint => sites[i].turn_a,
+        SourceCategory::SegmentEnd => sites[i].turn_b,
+        SourceCategory::Segment => 0.0,
     }
 }
 

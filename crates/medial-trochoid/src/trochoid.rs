@@ -75,9 +75,15 @@ pub fn straight_engagement(r: f64, rt: f64, pitch: f64, step: f64) -> f64 {
     samples.iter().zip(e).filter(|((i, _), _)| prog.moves[*i].tag != Tag::Entry).map(|(_, e)| e).fold(0.0, f64::max)
 }
 
-/// The largest pitch (mm) whose trochoids stay at or under `threshold` degrees (bisection on
-/// the simulated engagement), or `None` if even a pitch of 1 % of the tool radius does not.
+/// Margin (degrees) under the threshold that the pitch search aims at: the loops of a program
+/// are sampled at other places than the straight run the pitch is chosen on.
+pub const PITCH_MARGIN_DEG: f64 = 0.25;
+
+/// The largest pitch (mm) whose trochoids stay at or under `threshold` degrees less
+/// [`PITCH_MARGIN_DEG`] (bisection on the simulated engagement), or `None` if even a pitch of
+/// 1 % of the tool radius does not.
 pub fn pitch_for(r: f64, rt: f64, threshold: f64, step: f64) -> Option<f64> {
+    let threshold = threshold - PITCH_MARGIN_DEG;
     let (mut lo, mut hi) = (0.01 * r, r);
     if straight_engagement(r, rt, lo, step) > threshold {
         return None;

@@ -1,0 +1,50 @@
+//! Times the medial axis (boostvoronoi) of a wavy star pocket with N segments and writes the
+//! segments it used (integer, 1e-6 mm grid) so that scripts/bench-trochoid.sh can give the same
+//! input to Boost.Voronoi (pyvoronoi). Usage: voronoi_bench N SEGMENTS_FILE.
+
+use camkit::contour::Contour;
+use camkit::contour::region::regions;
+use camkit::geom::P2;
+use medial_trochoid::medial::{MedialOptions, medial_axis};
+use std::io::Write;
+use std::time::Instant;
+
+fn main() {
+    let args: Vec<String> = std::env::args().collect();
+    let n: usize = args.get(1).and_then(|s| s.parse().ok()).unwrap_or(1000);
+    let file = args.get(2).cloned().unwrap_or_else(|| "segments.txt".into());
+    // A star with 7 lobes and a fine ripple: no two segments cross, many reflex vertices.
+    let pts: Vec<P2> = (0..n)
+        .map(|k| {
+            let t = k as f64 / n as f64 * std::f64::consts::TAU;
+            let r = 40.0 + 8.0 * (7.0 * t).sin() + 0.3 * ((n as f64 / 4.0).floor() * t).sin();
+            P2::new(r * t.cos(), r * t.sin())
+        })
+        .collect();
+    let region = regions(&[Contour::polygon(&pts, true)]).expect("a simple star").0.remove(0);
+    let opts = MedialOptions::default();
+    let (mut times, mut builds) = (Vec::new(), Vec::new());
+    let mut edges = 0;
+    for _ in 0..7 {
+        let t0 = Instant::now();
+        let m = medial_axis(&region, &opts).expect("medial axis");
+        times.push(t0.elapsed().as_secs_f64());
+        builds.push(m.build_seconds);
+        edges = m.edges.len();
+    }
+    times.sort_by(f64::total_cmp);
+    builds.sort_by(f64::total_cmp);
+    let mut f = std::fs::File::create(&file).expect("segments file");
+    let (lo, hi) = region.outer.bounds().expect("bounds");
+    let o = P2::new(0.5 * (lo.x + hi.x), 0.5 * (lo.y + hi.y));
+    for k in 0..n {
+        let (a, b) = (pts[k], pts[(k + 1) % n]);
+        let s = |v: f64, c: f64| ((v - c) / opts.resolution).round() as i64;
+        writeln!(f, "{} {} {} {}", s(a.x, o.x), s(a.y, o.y), s(b.x, o.x), s(b.y, o.y)).expect("write");
+    }
+    println!(
+        "segments {n} medial_edges {edges} median_ms {:.3} (voronoi build alone {:.3})",
+        times[3] * 1e3,
+        builds[3] * 1e3
+    );
+}
