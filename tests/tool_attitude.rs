@@ -228,10 +228,11 @@ fn flat_type_tool_lies_on_the_control_surface() {
     );
     w.write("t3.json", r#"{"kind": "flat-nonrotating", "radius": 5, "included_angle": 65, "flank_length": 3}"#);
     let corner = 180.0 - (-9.0f64 / 26.0).acos().to_degrees();
-    // P1 on the floor: no correction, the flank on the plane, the second flank off by corner − 65°.
+    // P1 on the floor: no control correction, the flank on the plane, the second flank off by
+    // corner − 65°, the axis off the bisector by half of that.
     let t = Rows::parse(&w.run(BIN, &["cl.csv", "--tool", "t3.json", "--model", "m.json"], b"").ok());
     for k in 0..t.rows.len() {
-        assert!(t.num(k, "tilt").abs() < 1e-9);
+        assert!((t.num(k, "tilt") - (65.0 - corner) / 2.0).abs() < 1e-9, "axis off the bisector by half the margin");
         assert!((t.num(k, "flank_gap") - (corner - 65.0)).abs() < 1e-9);
         assert!(t.num(k, "gouge") < 1e-9, "flank on the floor");
         let a = t.axis(k);
@@ -240,15 +241,16 @@ fn flat_type_tool_lies_on_the_control_surface() {
         assert!((a.z - 32.5f64.to_radians().sin()).abs() < 1e-9);
         assert!(t.num(k, "s").is_finite());
     }
-    // P3 on the sphere: the control point touches the offset sphere (R 26), the axis turns by
-    // asin(L / 2·26) and the straight flank's chord sinks by the sagitta 26 − √(26² − (L/2)²).
+    // P3 on the sphere: the control point touches the offset sphere (R 26), the axis turns a
+    // further asin(L / 2·26) toward it and the straight flank's chord sinks by the sagitta 26 − √(26² − (L/2)²).
     let out =
         w.run(BIN, &["cl.csv", "--tool", "t3.json", "--model", "m.json", "--control", "p3", "--allow-gouge"], b"");
     assert_eq!(out.status, 0);
     let t = Rows::parse(&out.out());
     let sag = 26.0 - (26.0f64.powi(2) - 1.5f64.powi(2)).sqrt();
     for k in 0..t.rows.len() {
-        assert!((t.num(k, "tilt").abs() - (3.0f64 / 52.0).asin().to_degrees()).abs() < 1e-5, "{}", t.num(k, "tilt"));
+        let expect = (65.0 - corner) / 2.0 - (3.0f64 / 52.0).asin().to_degrees();
+        assert!((t.num(k, "tilt") - expect).abs() < 1e-5, "{} vs {expect}", t.num(k, "tilt"));
         assert!((t.num(k, "gouge") - sag).abs() < 1e-6, "{} vs {sag}", t.num(k, "gouge"));
     }
 }

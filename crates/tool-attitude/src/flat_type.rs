@@ -33,7 +33,8 @@ pub struct Edge {
 pub struct FlatPose {
     /// Tip P2, axis, and the direction the cutting face looks (the feed).
     pub pose: Pose,
-    /// Correction of the axis from the bisector (radians, positive away from the control surface).
+    /// Turn of the control flank from the control surface's tangent (radians, positive away from
+    /// it) that brings the control stylus onto the surface.
     pub correction: f64,
     /// The model's corner angle between the surfaces in the section (radians).
     pub corner_angle: f64,

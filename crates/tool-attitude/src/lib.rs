@@ -85,7 +85,9 @@ pub struct Contact {
 pub struct Attitude {
     /// The pose.
     pub pose: Pose,
-    /// Tilt used (radians): θ, ζ, or the flat-type correction from the bisector.
+    /// Tilt used (radians): θ, ζ, or for the flat-type tool the angle of the axis from the
+    /// bisector of both normals (the paper's correction, fig. 10), positive away from the
+    /// control surface: half the included-angle margin plus the control-stylus correction.
     pub tilt: f64,
     /// R' of eq. (1) (cylinder; `None` where infinite or undefined).
     pub edge_radius: Option<f64>,
@@ -184,7 +186,7 @@ pub fn attitude(setup: &Setup, c: &Contact, model: Option<&Model>) -> Result<Att
             });
             Ok(Attitude {
                 pose: fp.pose,
-                tilt: fp.correction,
+                tilt: fp.correction + (edge.included - fp.corner_angle) / 2.0,
                 edge_radius: None,
                 machine: None,
                 flank_gap: Some(fp.flank_gap),

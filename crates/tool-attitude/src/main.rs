@@ -382,7 +382,7 @@ fn run(args: Args) -> Result<()> {
     if !gaps.is_empty() {
         report.set("flank_gap_min_deg", gaps.iter().copied().fold(f64::INFINITY, f64::min).to_degrees());
         let corrections = poses.iter().map(|a| a.tilt.abs()).fold(0.0, f64::max);
-        report.set("largest_correction_deg", corrections.to_degrees());
+        report.set("largest_axis_from_bisector_deg", corrections.to_degrees());
     }
     if let Some(path) = &args.io.report {
         report.write(path)?;
