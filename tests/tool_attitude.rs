@@ -353,3 +353,26 @@ fn bad_input_is_refused_with_its_place() {
     run(&stream(&ok, 12.5), &[]).fails(2, "tool.json (kind)");
     assert!(!w.exists("out.csv"), "nothing written on bad input");
 }
+
+#[test]
+fn output_is_the_same_for_any_thread_count() {
+    let w = Work::new();
+    w.write(
+        "m.json",
+        r#"{"surfaces": [{"type": "cylinder", "point": [0, 0, 100], "axis": [0, 1, 0], "radius": 100, "flip": true}]}"#,
+    );
+    let contacts = circle(P3::new(0.0, 0.0, 100.0), (V3::x(), V3::z()), 100.0, (-1.7, 0.01, 40), true);
+    w.write("cl.csv", stream(&contacts, 12.5));
+    w.write("tool.json", CYL);
+    let run = |threads: &str| {
+        let out = std::process::Command::new(e2e::bin(BIN))
+            .args(["cl.csv", "--tool", "tool.json", "--model", "m.json"])
+            .current_dir(w.path(""))
+            .env("RAYON_NUM_THREADS", threads)
+            .output()
+            .expect("run");
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        out.stdout
+    };
+    assert_eq!(run("1"), run("3"));
+}
