@@ -116,6 +116,7 @@ pub const COLUMNS: &[ColumnSpec] = &[
     named!("gouge", "mm", "empty", "tool-attitude --model: deepest penetration of the tool body into the model"),
     named!("ac_a", "deg", "empty", "tool-attitude: A angle of paper 002 eq. 3 (A/C table machine)"),
     named!("ac_c", "deg", "empty", "tool-attitude: C angle of paper 002 eq. 4"),
+    named!("engagement", "deg", "empty", "medial-trochoid: engagement angle of the tool at the row's end, from the material-removal simulation"),
 ];
 
 /// The spec of a typed column.
