@@ -10,6 +10,8 @@ CONCAVE_REMAINDER_TOOL ?= data/tool-attitude/flat-type.json
 CONCAVE_REMAINDER_CONTROL ?= p1
 CONCAVE_REMAINDER_MACHINE ?= data/post-6axis/paper000-sixaxis-m19.json
 CONCAVE_REMAINDER_FEED ?= 500
+# Read-back tolerance of the NC (mm): the issue asks for the demo parts within 1 µm.
+CONCAVE_REMAINDER_NC_TOL ?= 0.001
 
 demo-concave-remainder: $(CONCAVE_REMAINDER_6AXIS)/tool.csv $(CONCAVE_REMAINDER_6AXIS)/part.nc
 
@@ -21,5 +23,5 @@ $(CONCAVE_REMAINDER_6AXIS)/tool.csv $(CONCAVE_REMAINDER_6AXIS)/tool.json &: $(CO
 
 $(CONCAVE_REMAINDER_6AXIS)/part.nc $(CONCAVE_REMAINDER_6AXIS)/part.json &: $(CONCAVE_REMAINDER_6AXIS)/tool.csv \
   $(CONCAVE_REMAINDER_MACHINE) $(RELEASE)/post-6axis
-	$(RELEASE)/post-6axis $< --machine $(CONCAVE_REMAINDER_MACHINE) --feed $(CONCAVE_REMAINDER_FEED) \
+	$(RELEASE)/post-6axis $< --machine $(CONCAVE_REMAINDER_MACHINE) --feed $(CONCAVE_REMAINDER_FEED) --tol $(CONCAVE_REMAINDER_NC_TOL) \
 	  --report $(CONCAVE_REMAINDER_6AXIS)/part.json -o $(CONCAVE_REMAINDER_6AXIS)/part.nc

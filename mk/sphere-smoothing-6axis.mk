@@ -9,6 +9,8 @@ SPHERE_SMOOTHING_TOOL ?= data/tool-attitude/cylinder-phi25.json
 SPHERE_SMOOTHING_TILT ?= -5
 SPHERE_SMOOTHING_MACHINE ?= data/post-6axis/paper000-sixaxis-b.json
 SPHERE_SMOOTHING_FEED ?= 1000
+# Read-back tolerance of the NC (mm): the issue asks for the demo parts within 1 µm.
+SPHERE_SMOOTHING_NC_TOL ?= 0.001
 
 demo-sphere-smoothing: $(SPHERE_SMOOTHING_6AXIS)/tool.csv $(SPHERE_SMOOTHING_6AXIS)/part.nc
 
@@ -20,5 +22,5 @@ $(SPHERE_SMOOTHING_6AXIS)/tool.csv $(SPHERE_SMOOTHING_6AXIS)/tool.json &: $(SPHE
 
 $(SPHERE_SMOOTHING_6AXIS)/part.nc $(SPHERE_SMOOTHING_6AXIS)/part.json &: $(SPHERE_SMOOTHING_6AXIS)/tool.csv \
   $(SPHERE_SMOOTHING_MACHINE) $(RELEASE)/post-6axis
-	$(RELEASE)/post-6axis $< --machine $(SPHERE_SMOOTHING_MACHINE) --feed $(SPHERE_SMOOTHING_FEED) \
+	$(RELEASE)/post-6axis $< --machine $(SPHERE_SMOOTHING_MACHINE) --feed $(SPHERE_SMOOTHING_FEED) --tol $(SPHERE_SMOOTHING_NC_TOL) \
 	  --report $(SPHERE_SMOOTHING_6AXIS)/part.json -o $(SPHERE_SMOOTHING_6AXIS)/part.nc
