@@ -23,6 +23,19 @@ for _ in range(7):
     edges = pv.CountEdges()
     times.append(time.perf_counter() - t0)
 times.sort()
-print(f"pyvoronoi: segments {len(segs)} voronoi_edges {edges} median_ms {times[3] * 1e3:.3f}")
+# Agreement: every end of our kept medial edges is a vertex of Boost's diagram (or an input
+# point), within the stated error (1e-6 mm = 1 unit of the integer grid).
+verts = [(v.X, v.Y) for v in pv.GetVertices()] + [(s[0], s[1]) for s in segs]
+grid = {}
+for v in verts:
+    grid.setdefault((round(v[0] / 100), round(v[1] / 100)), []).append(v)
+worst = 0.0
+for l in open(sys.argv[1] + ".ends"):
+    x, y = map(float, l.split())
+    k = (round(x / 100), round(y / 100))
+    near = [v for dx in (-1, 0, 1) for dy in (-1, 0, 1) for v in grid.get((k[0] + dx, k[1] + dy), [])]
+    worst = max(worst, min(((v[0] - x) ** 2 + (v[1] - y) ** 2) ** 0.5 for v in near) if near else float("inf"))
+print(f"pyvoronoi: segments {len(segs)} voronoi_edges {edges} median_ms {times[3] * 1e3:.3f}; "
+      f"largest distance of our edge ends to its vertices {worst * 1e-6:.2e} mm")
 PY
 done

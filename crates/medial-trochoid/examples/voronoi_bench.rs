@@ -1,6 +1,7 @@
 //! Times the medial axis (boostvoronoi) of a wavy star pocket with N segments and writes the
 //! segments it used (integer, 1e-6 mm grid) so that scripts/bench-trochoid.sh can give the same
-//! input to Boost.Voronoi (pyvoronoi). Usage: voronoi_bench N SEGMENTS_FILE.
+//! input to Boost.Voronoi (pyvoronoi), and the ends of the kept medial edges in the same integer
+//! frame to SEGMENTS_FILE.ends. Usage: voronoi_bench N SEGMENTS_FILE.
 
 use camkit::contour::Contour;
 use camkit::contour::region::regions;
@@ -25,12 +26,14 @@ fn main() {
     let opts = MedialOptions::default();
     let (mut times, mut builds) = (Vec::new(), Vec::new());
     let mut edges = 0;
+    let mut ends: Vec<P2> = Vec::new();
     for _ in 0..7 {
         let t0 = Instant::now();
         let m = medial_axis(&region, &opts).expect("medial axis");
         times.push(t0.elapsed().as_secs_f64());
         builds.push(m.build_seconds);
         edges = m.edges.len();
+        ends = m.edges.iter().flat_map(|e| [e.points[0], e.points[e.points.len() - 1]]).collect();
     }
     times.sort_by(f64::total_cmp);
     builds.sort_by(f64::total_cmp);
@@ -41,6 +44,10 @@ fn main() {
         let (a, b) = (pts[k], pts[(k + 1) % n]);
         let s = |v: f64, c: f64| ((v - c) / opts.resolution).round() as i64;
         writeln!(f, "{} {} {} {}", s(a.x, o.x), s(a.y, o.y), s(b.x, o.x), s(b.y, o.y)).expect("write");
+    }
+    let mut g = std::fs::File::create(format!("{file}.ends")).expect("ends file");
+    for p in &ends {
+        writeln!(g, "{} {}", (p.x - o.x) / opts.resolution, (p.y - o.y) / opts.resolution).expect("write");
     }
     println!(
         "segments {n} medial_edges {edges} median_ms {:.3} (voronoi build alone {:.3})",
