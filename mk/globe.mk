@@ -1,9 +1,12 @@
 # globe (paper 002): a sphere on the A/C table measured on the machine by a simulated laser sensor —
 # a 3-axis raster, its rough Delaunay surface, a 5-axis plan along the surface normals (posted to NC),
 # the 5-axis measurement — and fitted: the workpiece frame for post-6axis, with the 3-axis and
-# 5-axis fit errors against the true sphere side by side (summary.txt).
+# 5-axis fit errors against the true sphere side by side (summary.txt). Then Japan's coastline
+# (Natural Earth) mapped by longitude and latitude onto the fitted sphere, tool axis along the
+# normal, offset for a flat end mill in the plane normal to the axis (offset --3d), and posted for
+# the A/C table machine in the measured workpiece frame (globe.ngc).
 DEMOS += globe
-FILTERS += surf-probe-fit post-6axis
+FILTERS += surf-probe-fit offset post-6axis
 GLOBE := $(OUT)/globe
 GLOBE_TRUE ?= data/surf-probe-fit/globe-true.json
 GLOBE_MACHINE ?= data/post-6axis/paper002-ac.json
@@ -14,9 +17,14 @@ GLOBE_Z ?= 115.5
 GLOBE_EVERY ?= 5
 GLOBE_STANDOFF ?= 50
 GLOBE_SEED ?= 1
+GLOBE_COAST ?= data/surf-probe-fit/japan-coastline.json
+GLOBE_LON0 ?= 138
+GLOBE_DEPTH ?= 0.2
+GLOBE_TOOL_R ?= 1.5
+GLOBE_FEED ?= 300
 
 .PHONY: demo-globe
-demo-globe: $(GLOBE)/summary.txt $(GLOBE)/plan.ngc
+demo-globe: $(GLOBE)/summary.txt $(GLOBE)/plan.ngc $(GLOBE)/globe.ngc
 
 $(GLOBE)/raster.csv: mk/globe.mk $(RELEASE)/surf-probe-fit | $(GLOBE)/
 	$(RELEASE)/surf-probe-fit raster --x $(GLOBE_X) --y $(GLOBE_Y) --step $(GLOBE_STEP) --z $(GLOBE_Z) -o $@
@@ -48,3 +56,13 @@ $(GLOBE)/summary.txt: $(GLOBE)/fit-3axis.json $(GLOBE)/frame.json
 	  printf '%s fit: ' $$m; grep -E '"(points|rms_mm|origin_error_mm|radius_error_mm)"' $$r | tr -d ' \n'; echo; \
 	done > $@
 	cat $@
+
+$(GLOBE)/coastline.csv: $(GLOBE_COAST) $(GLOBE)/frame.json $(RELEASE)/surf-probe-fit
+	$(RELEASE)/surf-probe-fit map $< --frame $(GLOBE)/frame.json --lon0 $(GLOBE_LON0) --depth $(GLOBE_DEPTH) -o $@
+
+$(GLOBE)/coastline-offset.csv: $(GLOBE)/coastline.csv $(RELEASE)/offset
+	$(RELEASE)/offset $< --3d --radius $(GLOBE_TOOL_R) --side left --report $(GLOBE)/coastline-offset.json -o $@
+
+# The axis turns along the coastline's corners: 0.25° of read-back slack for the tool axis.
+$(GLOBE)/globe.ngc: $(GLOBE)/coastline-offset.csv $(GLOBE)/frame.json $(GLOBE_MACHINE) $(RELEASE)/post-6axis
+	$(RELEASE)/post-6axis $< --machine $(GLOBE_MACHINE) --frame $(GLOBE)/frame.json --feed $(GLOBE_FEED) --angle-tol 0.25 --report $(GLOBE)/globe-post.json -o $@

@@ -157,3 +157,31 @@ fn bad_input_is_refused() {
     assert_eq!(o.stderr.trim_end().lines().count(), 1, "{}", o.stderr);
     assert!(!w.exists("out.json"), "no partial output");
 }
+
+#[test]
+fn coastline_on_the_fitted_sphere_is_offset_normal_to_the_tool_axis() {
+    let w = Work::new();
+    w.run(BIN, &["reference", "--centre", "3.2,-1.7,40.5", "--extent", "90", "--points", "300", "-o", "pts.csv"], b"")
+        .ok();
+    w.run(BIN, &["fit", "pts.csv", "-o", "frame.json"], b"").ok();
+    let coast = d("surf-probe-fit/japan-coastline.json");
+    let args = ["map", &coast, "--frame", "frame.json", "--lon0", "138", "--depth", "0.2", "-o", "coast.csv"];
+    w.run(BIN, &args, b"").ok();
+    let radius = json(&w, "frame.json")["fit"]["radius"].as_f64().unwrap();
+    let text = w.read("coast.csv");
+    let mut rows = 0;
+    for line in text.lines().skip(1) {
+        let v: Vec<f64> = line.split(',').skip(2).take(6).map(|x| x.parse().unwrap()).collect();
+        let r = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+        assert!((r - (radius - 0.2)).abs() < 1e-9, "{line}");
+        assert!((v[0] / r - v[3]).abs() < 1e-9 && (v[2] / r - v[5]).abs() < 1e-9, "axis along the normal: {line}");
+        rows += 1;
+    }
+    assert!(rows > 100);
+    w.run("offset", &["coast.csv", "--3d", "--radius", "1.5", "--side", "left", "-o", "off.csv"], b"").ok();
+    // (post-6axis turns this into NC in the globe demo; on this reference frame its read-back
+    // finds one offset row 0.94 mm from the program: reported to its owner, not asserted here.)
+    assert!(w.read("off.csv").lines().count() > 100);
+    w.write("bad.json", r#"{"parts": [[[140, 40]]]}"#);
+    w.run(BIN, &["map", "bad.json", "--frame", "frame.json", "-o", "x.csv"], b"").fails(2, "parts[0]");
+}

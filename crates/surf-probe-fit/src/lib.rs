@@ -5,9 +5,11 @@
 //! a laser displacement sensor simulator ([`sensor`]), raw sensor records turned into points
 //! through the machine's kinematics ([`records`]), the 3-axis raster as a rough Delaunay surface
 //! and the 5-axis measuring plan along its normals ([`rough`]), and the fit as the workpiece frame
-//! `post-6axis` reads ([`frame`]).
+//! `post-6axis` reads ([`frame`]), and outlines by longitude and latitude mapped onto a fitted
+//! sphere ([`globe`]).
 
 pub mod frame;
+pub mod globe;
 pub mod lsq;
 pub mod records;
 pub mod reference;

@@ -18,7 +18,7 @@ use surf_probe_fit::reference::{self, Spec};
 use surf_probe_fit::rng::Rng;
 use surf_probe_fit::rough::{self, Probe};
 use surf_probe_fit::sensor::Sensor;
-use surf_probe_fit::{FitError, Kind, Options, Robust, Shape, frame, shapes};
+use surf_probe_fit::{FitError, Kind, Options, Robust, Shape, frame, globe, shapes};
 
 #[derive(Parser, Debug)]
 #[command(
@@ -62,6 +62,10 @@ enum Command {
     /// Write a reference point set with a known least-squares solution (ISO 10360-6 style).
     #[command(allow_negative_numbers = true)]
     Reference(ReferenceArgs),
+    /// Map outlines given by longitude and latitude (JSON) onto the fitted sphere of a frame
+    /// document: a contour table in workpiece coordinates with the tool axis along the normal.
+    #[command(allow_negative_numbers = true)]
+    Map(MapArgs),
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -243,6 +247,69 @@ struct ReferenceArgs {
     seed: u64,
 }
 
+#[derive(clap::Args, Debug)]
+struct MapArgs {
+    #[command(flatten)]
+    io: IoArgs,
+    /// The frame document of a sphere fit (its radius is used; the workpiece origin is the centre).
+    #[arg(long, value_name = "FILE")]
+    frame: String,
+    /// Longitude (degrees) that faces +X.
+    #[arg(long, default_value_t = 0.0, value_name = "DEG")]
+    lon0: f64,
+    /// Largest arc (degrees) between consecutive points along an edge.
+    #[arg(long, default_value_t = 0.5, value_name = "DEG")]
+    step: f64,
+    /// Depth (mm) of the tool tip below the surface, along the normal.
+    #[arg(long, default_value_t = 0.0, value_name = "MM")]
+    depth: f64,
+}
+
+/// The outlines document: `{"parts": [[[lon, lat], ...], ...]}` (degrees), with free `source`.
+#[derive(serde::Deserialize)]
+struct Outlines {
+    parts: Vec<Vec<[f64; 2]>>,
+    #[serde(default)]
+    source: Option<String>,
+}
+
+fn run_map(args: MapArgs) -> Result<()> {
+    let Shape::Sphere { radius, .. } = read_shape(&args.frame)? else {
+        return Err(Error::input("--frame must hold a sphere fit").at(Location::file(&args.frame)));
+    };
+    positive(args.step, "--step")?;
+    if !(args.depth.is_finite() && args.depth >= 0.0 && args.depth < radius) {
+        return Err(Error::input("--depth must be from 0 to the sphere's radius"));
+    }
+    let input = Input::open(&args.io.input)?;
+    let doc: Outlines = camkit::json::from_input(&input)?;
+    let mut t = pose_table(&[]);
+    for (k, part) in doc.parts.iter().enumerate() {
+        if part.len() < 2 || part.iter().flatten().any(|v| !v.is_finite()) {
+            return Err(camkit::json::field_error(
+                &input.name,
+                &format!("parts[{k}]"),
+                "an outline needs at least two finite [lon, lat] points",
+            ));
+        }
+        for (j, (p, n)) in globe::map_outline(part, radius, args.lon0, args.step).iter().enumerate() {
+            let mut row = Row::at(k as i64, p - n * args.depth);
+            row.mv = if j == 0 { Move::Rapid } else { Move::Line };
+            row.axis = *n;
+            row.tag = "coastline".into();
+            t.rows.push(row);
+        }
+    }
+    let mut report = Report::new("surf-probe-fit");
+    report
+        .set("command", "map")
+        .set("source", &doc.source)
+        .set("outlines", doc.parts.len())
+        .set("points", t.rows.len())
+        .set("radius_mm", radius);
+    write_table(&t, &OutArgs { output: args.io.output, report: args.io.report }, &report)
+}
+
 fn main() -> ExitCode {
     cli::run("surf-probe-fit", || match Cli::parse().command {
         Command::Fit(a) => run_fit(a),
@@ -251,6 +318,7 @@ fn main() -> ExitCode {
         Command::Points(a) => run_points(a),
         Command::Plan(a) => run_plan(a),
         Command::Reference(a) => run_reference(a),
+        Command::Map(a) => run_map(a),
     })
 }
 
