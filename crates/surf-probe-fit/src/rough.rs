@@ -1,6 +1,6 @@
 //! The rough shape of paper 002 §3: the 3-axis raster as a Delaunay triangulation of the scanned
-//! points over XY (spade), with a normal per facet and an area-weighted normal per point, before
-//! any element is assumed; and the 5-axis measuring plan — sensor poses with the beam along the
+//! points over XY (spade), with a normal per facet and a normal per point (a quadric fitted to its
+//! two-ring of neighbours), before any element is assumed; and the 5-axis measuring plan — sensor poses with the beam along the
 //! normal at the sensor's stand-off — from that surface or from a fitted sphere.
 
 use camkit::geom::{P3, V3};
@@ -27,12 +27,13 @@ pub struct RoughSurface {
     pub facets: Vec<[usize; 3]>,
     /// Unit normal of each facet (pointing up, +Z side).
     pub facet_normals: Vec<V3>,
-    /// Area-weighted unit normal at each input point (`None` for points in no facet: repeats of
-    /// an XY position).
+    /// Unit normal at each input point: the normal of a quadric fitted to its two-ring, or the
+    /// area-weighted mean of its facets' normals where that fit is not determined (`None` for
+    /// points in no facet: repeats of an XY position).
     pub normals: Vec<Option<V3>>,
 }
 
-/// Triangulates `points` over XY and computes facet and point normals (area-weighted means). Facets steeper than
+/// Triangulates `points` over XY and computes facet and point normals. Facets steeper than
 /// `max_slope_deg` (the long slivers along the convex hull of a scanned dome) are dropped.
 pub fn triangulate(points: &[P3], max_slope_deg: f64) -> Result<RoughSurface, String> {
     let mut t: DelaunayTriangulation<Vertex> = DelaunayTriangulation::new();
@@ -63,8 +64,54 @@ pub fn triangulate(points: &[P3], max_slope_deg: f64) -> Result<RoughSurface, St
     if facets.is_empty() {
         return Err("the points form no triangle (all on one line, or every facet steeper than the limit)".into());
     }
-    let normals = sums.iter().map(|s| (s.norm() > 0.0).then(|| s.normalize())).collect();
+    let area: Vec<Option<V3>> = sums.iter().map(|s| (s.norm() > 0.0).then(|| s.normalize())).collect();
+    let mut ring: Vec<Vec<usize>> = vec![Vec::new(); points.len()];
+    for f in &facets {
+        for (a, b) in [(f[0], f[1]), (f[1], f[2]), (f[2], f[0])] {
+            ring[a].push(b);
+            ring[b].push(a);
+        }
+    }
+    let normals = (0..points.len())
+        .map(|i| {
+            let n0 = area[i]?;
+            let mut near: Vec<usize> = ring[i].iter().flat_map(|&j| ring[j].iter().copied().chain([j])).collect();
+            near.sort_unstable();
+            near.dedup();
+            near.retain(|&j| j != i);
+            Some(quadric_normal(points, i, &near, n0).unwrap_or(n0))
+        })
+        .collect();
     Ok(RoughSurface { facets, facet_normals, normals })
+}
+
+/// The normal at point `i` of the quadric `h = a s + b t + c s² + d s t + e t² + f` fitted by least
+/// squares to its neighbours `near` (the two-ring of the triangulation) in the frame of the facet
+/// normal `n0`: exact for a locally quadratic surface, so it does not lean with an asymmetric fan
+/// of facets as facet averages do. `None` with fewer than 6 neighbours or a singular fit.
+fn quadric_normal(points: &[P3], i: usize, near: &[usize], n0: V3) -> Option<V3> {
+    if near.len() < 6 {
+        return None;
+    }
+    let (u, v) = crate::shapes::basis(&n0);
+    let mut ata = nalgebra::SMatrix::<f64, 6, 6>::zeros();
+    let mut atb = nalgebra::SVector::<f64, 6>::zeros();
+    let mut scale: f64 = 0.0;
+    for &j in near {
+        let d = points[j] - points[i];
+        scale = scale.max(d.norm());
+    }
+    for &j in near.iter().chain([&i]) {
+        let d = (points[j] - points[i]) / scale;
+        let (s, t, h) = (u.dot(&d), v.dot(&d), n0.dot(&d));
+        let row = nalgebra::SVector::<f64, 6>::from([s, t, s * s, s * t, t * t, 1.0]);
+        ata.syger(1.0, &row, &row, 1.0);
+        atb += row * h;
+    }
+    ata.fill_upper_triangle_with_lower_triangle();
+    let x = ata.cholesky()?.solve(&atb);
+    let n = (n0 - u * x[0] - v * x[1]).normalize();
+    n.iter().all(|c| c.is_finite()).then_some(n)
 }
 
 /// One planned sensor pose.
