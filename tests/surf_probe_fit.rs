@@ -185,3 +185,19 @@ fn coastline_on_the_fitted_sphere_is_offset_normal_to_the_tool_axis() {
     w.write("bad.json", r#"{"parts": [[[140, 40]]]}"#);
     w.run(BIN, &["map", "bad.json", "--frame", "frame.json", "-o", "x.csv"], b"").fails(2, "parts[0]");
 }
+
+#[test]
+fn free_form_height_field_from_the_raster() {
+    let w = Work::new();
+    let truth = d("surf-probe-fit/globe-true.json");
+    let args = ["raster", "--x", "-8,14", "--y", "-11,7", "--step", "1", "--z", "115.5", "-o", "raster.csv"];
+    w.run(BIN, &args, b"").ok();
+    let args = ["simulate", "raster.csv", "--shape", &truth, "--slope-error", "0", "-o", "rec.csv"];
+    w.run(BIN, &args, b"").ok();
+    w.run(BIN, &["surface", "rec.csv", "--net", "8,8", "-o", "model.json", "--report", "s.json"], b"").ok();
+    let r = json(&w, "s.json");
+    assert!(r["rms_mm"].as_f64().unwrap() < 0.002, "{r}");
+    assert_eq!(json(&w, "model.json")["surfaces"][0]["control_points"].as_array().unwrap().len(), 8);
+    w.run(BIN, &["surface", "rec.csv", "--net", "30,30", "-o", "x.json"], b"")
+        .fails(2, "a 30x30 net needs at least 900");
+}

@@ -6,10 +6,11 @@
 //! through the machine's kinematics ([`records`]), the 3-axis raster as a rough Delaunay surface
 //! and the 5-axis measuring plan along its normals ([`rough`]), and the fit as the workpiece frame
 //! `post-6axis` reads ([`frame`]), and outlines by longitude and latitude mapped onto a fitted
-//! sphere ([`globe`]).
+//! sphere ([`globe`]); for free-form parts, a bicubic B-spline height field ([`heightfield`]).
 
 pub mod frame;
 pub mod globe;
+pub mod heightfield;
 pub mod lsq;
 pub mod records;
 pub mod reference;

@@ -18,7 +18,7 @@ use surf_probe_fit::reference::{self, Spec};
 use surf_probe_fit::rng::Rng;
 use surf_probe_fit::rough::{self, Probe};
 use surf_probe_fit::sensor::Sensor;
-use surf_probe_fit::{FitError, Kind, Options, Robust, Shape, frame, globe, shapes};
+use surf_probe_fit::{FitError, Kind, Options, Robust, Shape, frame, globe, heightfield, shapes};
 
 #[derive(Parser, Debug)]
 #[command(
@@ -62,6 +62,10 @@ enum Command {
     /// Write a reference point set with a known least-squares solution (ISO 10360-6 style).
     #[command(allow_negative_numbers = true)]
     Reference(ReferenceArgs),
+    /// Fit a bicubic B-spline height field z(x, y) to points or raw records (free-form parts);
+    /// write it as a model document (a `bspline` surface) that stylus-trace reads.
+    #[command(allow_negative_numbers = true)]
+    Surface(SurfaceArgs),
     /// Map outlines given by longitude and latitude (JSON) onto the fitted sphere of a frame
     /// document: a contour table in workpiece coordinates with the tool axis along the normal.
     #[command(allow_negative_numbers = true)]
@@ -248,6 +252,54 @@ struct ReferenceArgs {
 }
 
 #[derive(clap::Args, Debug)]
+struct SurfaceArgs {
+    #[command(flatten)]
+    io: IoArgs,
+    /// Machine document of raw records (default: 3-axis).
+    #[arg(long, short = 'm', value_name = "FILE")]
+    machine: Option<String>,
+    /// Control points along x and y (each at least 4).
+    #[arg(long, value_delimiter = ',', default_values_t = [10, 10], value_name = "NU,NV")]
+    net: Vec<usize>,
+}
+
+fn run_surface(args: SurfaceArgs) -> Result<()> {
+    if args.net.len() != 2 || args.net.iter().any(|&n| !(4..=60).contains(&n)) {
+        return Err(Error::input("--net takes two counts NU,NV from 4 to 60"));
+    }
+    let input = Input::open(&args.io.input)?;
+    let (_, pts) = read_points(&input, args.machine.as_deref())?;
+    if pts.len() < args.net[0] * args.net[1] {
+        return Err(Error::input(format!(
+            "{} points: a {}x{} net needs at least {}",
+            pts.len(),
+            args.net[0],
+            args.net[1],
+            args.net[0] * args.net[1]
+        ))
+        .at(Location::file(&input.name)));
+    }
+    let h = heightfield::fit(&pts, args.net[0], args.net[1])
+        .ok_or_else(|| Error::input("the points span no area in x and y").at(Location::file(&input.name)))?;
+    let doc =
+        serde_json::json!({"surfaces": [{"type": "bspline", "name": "measured", "control_points": h.control_points}]});
+    let mut out = Output::new(args.io.output.as_deref());
+    out.buf = serde_json::to_vec_pretty(&doc).map_err(|e| Error::runtime(e.to_string()))?;
+    out.buf.push(b'\n');
+    let mut report = Report::new("surf-probe-fit");
+    report
+        .set("command", "surface")
+        .set("points", pts.len())
+        .set("net", &args.net)
+        .set("rms_mm", h.rms)
+        .set("largest_residual_mm", h.largest_residual);
+    if let Some(path) = &args.io.report {
+        report.write(path)?;
+    }
+    out.commit()
+}
+
+#[derive(clap::Args, Debug)]
 struct MapArgs {
     #[command(flatten)]
     io: IoArgs,
@@ -319,6 +371,7 @@ fn main() -> ExitCode {
         Command::Plan(a) => run_plan(a),
         Command::Reference(a) => run_reference(a),
         Command::Map(a) => run_map(a),
+        Command::Surface(a) => run_surface(a),
     })
 }
 
