@@ -105,10 +105,20 @@ pub const COLUMNS: &[ColumnSpec] = &[
     named!("bx", "unit vector", "empty", "bisector of both contact normals (basic tool axis, paper 000 fig. 10), x"),
     named!("by", "unit vector", "empty", "bisector, y"),
     named!("bz", "unit vector", "empty", "bisector, z"),
-    named!("a", "degrees", "0", "surf-probe-fit raw sensor records: A axis position (each rotary axis of the machine by its letter)"),
+    named!(
+        "a",
+        "degrees",
+        "0",
+        "surf-probe-fit raw sensor records: A axis position (each rotary axis of the machine by its letter)"
+    ),
     named!("b", "degrees", "0", "surf-probe-fit raw sensor records: B axis position"),
     named!("c", "degrees", "0", "surf-probe-fit raw sensor records: C axis position"),
-    named!("reading", "mm", "required in records", "surf-probe-fit: laser sensor reading, distance along the beam (−tool axis)"),
+    named!(
+        "reading",
+        "mm",
+        "required in records",
+        "surf-probe-fit: laser sensor reading, distance along the beam (−tool axis)"
+    ),
     named!("incidence", "degrees", "empty", "surf-probe-fit simulate: angle between the beam and the surface normal"),
     named!("tilt", "deg", "empty", "tool-attitude: tilt used (θ cylinder, ζ ball, flat-type axis correction)"),
     named!("r_edge", "mm", "empty", "tool-attitude: R' of paper 000 eq. 1 (cylindrical tool; empty: infinite)"),
@@ -116,7 +126,12 @@ pub const COLUMNS: &[ColumnSpec] = &[
     named!("gouge", "mm", "empty", "tool-attitude --model: deepest penetration of the tool body into the model"),
     named!("ac_a", "deg", "empty", "tool-attitude: A angle of paper 002 eq. 3 (A/C table machine)"),
     named!("ac_c", "deg", "empty", "tool-attitude: C angle of paper 002 eq. 4"),
-    named!("engagement", "deg", "empty", "medial-trochoid: engagement angle of the tool at the row's end, from the material-removal simulation"),
+    named!(
+        "engagement",
+        "deg",
+        "empty",
+        "medial-trochoid: engagement angle of the tool at the row's end, from the material-removal simulation"
+    ),
 ];
 
 /// The spec of a typed column.
