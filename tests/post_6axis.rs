@@ -132,9 +132,7 @@ fn blocks(nc: &str) -> Vec<[f64; 5]> {
     for line in nc.lines() {
         let line = line.split('(').next().unwrap();
         let words: Vec<&str> = line.split_whitespace().collect();
-        if words.iter().any(|w| *w == "G53")
-            || !words.iter().any(|w| ["X", "Y", "Z", "A", "C"].iter().any(|l| w.starts_with(l)))
-        {
+        if words.contains(&"G53") || !words.iter().any(|w| ["X", "Y", "Z", "A", "C"].iter().any(|l| w.starts_with(l))) {
             continue;
         }
         for w in words {
@@ -473,13 +471,13 @@ fn linuxcnc_interpreter_agrees() {
             if m.machine_coords {
                 continue;
             }
-            for k in 0..6 {
+            for (k, tk) in t.iter().enumerate().take(6) {
                 if m.known[k] {
                     assert!(
-                        (t[k] - m.pos[k]).abs() <= 0.5e-4 + 1e-9,
+                        (tk - m.pos[k]).abs() <= 0.5e-4 + 1e-9,
                         "{name}: line {} axis {k}: {} vs {}",
                         m.line,
-                        t[k],
+                        tk,
                         m.pos[k]
                     );
                 }
