@@ -377,6 +377,34 @@ fn the_workpiece_frame_document_moves_the_program() {
     e.fails(2, "missing field `za`");
 }
 
+/// The globe demo's coastline, offset on a sphere fitted to a reference point set (not the demo's
+/// measured frame): the offset passes close on themselves, and the read-back once looked for a
+/// pass's first row near its closing visit (a row "0.94 mm" from the program) and measured the
+/// axis of a turn on the spot against the next segment's (0.21°). Both were the check's, not the
+/// program's: the default tolerances pass, every row on the program within 5 µm.
+#[test]
+fn closed_offset_passes_on_a_reference_frame_read_back() {
+    let w = Work::new();
+    let fit = "surf-probe-fit";
+    w.run(fit, &["reference", "--centre", "3.2,-1.7,40.5", "--extent", "90", "--points", "300", "-o", "pts.csv"], b"")
+        .ok();
+    w.run(fit, &["fit", "pts.csv", "-o", "frame.json"], b"").ok();
+    let coast = data("surf-probe-fit/japan-coastline.json").to_str().unwrap().to_string();
+    w.run(fit, &["map", &coast, "--frame", "frame.json", "--lon0", "138", "--depth", "0.2", "-o", "coast.csv"], b"")
+        .ok();
+    w.run("offset", &["coast.csv", "--3d", "--radius", "1.5", "--side", "left", "-o", "off.csv"], b"").ok();
+    let m = machine("paper002-ac.json");
+    let args = ["off.csv", "-m", &m, "--frame", "frame.json", "--feed", "300", "-o", "globe.nc", "--report", "r.json"];
+    w.run(BIN, &args, b"").ok();
+    let r = report(&w, "r.json");
+    assert!(figure(&r, "largest_row_distance_mm") < 0.001, "{r}");
+    assert!(figure(&r, "largest_tip_deviation_mm") <= 0.005, "{r}");
+    assert!(figure(&r, "largest_axis_deviation_deg") <= 0.05, "{r}");
+    let args = ["off.csv", "-m", &m, "--frame", "frame.json", "--feed", "300", "--verify", "globe.nc"];
+    let v: serde_json::Value = serde_json::from_str(&w.run(BIN, &args, b"").ok()).expect("JSON");
+    assert!(figure(&v, "largest_row_distance_mm") < 0.001, "{v}");
+}
+
 #[test]
 fn bad_input_is_refused_without_output() {
     let w = Work::new();

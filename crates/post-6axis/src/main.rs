@@ -137,7 +137,7 @@ fn run(args: Args) -> Result<()> {
         let program = read_axes(&nc_input.name, nc_input.text()?)?;
         let reading = readback::Reading::new(&machine, &chain);
         let poses = readback::poses(&program, &reading);
-        let d = readback::verify(&rows, &poses, &reading, 32, 1.0);
+        let d = readback::verify(&rows, &poses, &reading, 32, settings.tol);
         deviation_keys(&mut report, &d);
         report.set("rows", rows.len()).set("tol_mm", settings.tol).set("angle_tol_deg", settings.angle_tol);
         out.buf = report.to_json().into_bytes();

@@ -3,7 +3,7 @@
 //! blocks and compared with the CL rows both ways (`--verify`), or written out as the toolpath
 //! table (`--reverse`).
 
-use crate::plan::{Cl, angle_between, point_segment, slerp};
+use crate::plan::{Cl, point_segment, slerp, vector_arc};
 use camkit::doc::machine::{Machine, SpindleMode};
 use camkit::gcode::{AXIS_LETTERS, AxisProgram, Motion};
 use camkit::geom::{P3, V3};
@@ -168,8 +168,13 @@ pub const CHUNK: usize = 8192;
 /// Compares a program with the CL rows it was made from: every feed block sampled
 /// `samples_per_block` times along the controller's linear interpolation of every axis against
 /// the CL polyline (tip, axis, spindle orientation), and every CL row against the program's path.
-/// Chunks of blocks and of rows run in parallel; the result is the same for any thread count.
-pub fn verify(cl: &[Cl], poses: &[Option<NcPose>], r: &Reading, samples_per_block: usize, far: f64) -> Deviation {
+/// `tol` is the tip tolerance: a windowed nearest-segment answer beyond it is searched again in
+/// full (a pass that closes or crosses itself can send the window to the wrong visit), so every
+/// distance above `tol` is exact; and the CL points within `tol` of the tip are where the tool
+/// may be for the axis check. Chunks of blocks and of rows run in parallel; the result is the
+/// same for any thread count.
+pub fn verify(cl: &[Cl], poses: &[Option<NcPose>], r: &Reading, samples_per_block: usize, tol: f64) -> Deviation {
+    let far = tol;
     let segs: Vec<(usize, usize)> = (1..cl.len()).filter(|&i| !cl[i].rapid).map(|i| (i - 1, i)).collect();
     // Feed blocks as (start, end) poses in program order; a G53 block or an unknown position
     // breaks the chain.
@@ -259,6 +264,34 @@ fn nearest_on_path(p: &P3, path: &[P3], hint: Option<usize>, far: f64) -> (usize
     best
 }
 
+/// Angle (radians) of the tool axis from the CL axis where the tool is: over the CL points within
+/// `tol` of the tip on segment `seg` (at distance `d`) and the segments it shares a row with, the
+/// least angle to the axis arc there. A short segment that turns the axis with the tip (nearly)
+/// still, or a pass closing on its start, leaves the tip's nearest parameter undefined: every
+/// axis along the turn is then where the tool may be, as planning measures it.
+fn axis_deviation(tip: &P3, axis: &V3, cl: &[Cl], segs: &[(usize, usize)], seg: usize, d: f64, tol: f64) -> f64 {
+    let (i0, i1) = segs[seg];
+    let at = |k: usize, dk: f64| {
+        let (a, b) = segs[k];
+        let len = (cl[b].tip - cl[a].tip).norm();
+        let u = param(tip, &cl[a].tip, &cl[b].tip);
+        let half = if len > 0.0 { (tol * tol - dk * dk).max(0.0).sqrt() / len } else { 1.0 };
+        let (lo, hi) = ((u - half).max(0.0), (u + half).min(1.0));
+        vector_arc(axis, &slerp(&cl[a].axis, &cl[b].axis, lo), &slerp(&cl[a].axis, &cl[b].axis, hi))
+    };
+    let mut best = at(seg, d);
+    let neighbours =
+        [seg.checked_sub(1).filter(|&k| segs[k].1 == i0), Some(seg + 1).filter(|&k| k < segs.len() && segs[k].0 == i1)];
+    for k in neighbours.into_iter().flatten() {
+        let (a, b) = segs[k];
+        let dk = point_segment(tip, &cl[a].tip, &cl[b].tip);
+        if dk <= tol {
+            best = best.min(at(k, dk));
+        }
+    }
+    best
+}
+
 /// The block part of [`verify`] for one chunk of consecutive feed blocks, the nearest-segment
 /// search starting at `hint` (none: a full search).
 fn check_blocks(
@@ -294,10 +327,9 @@ fn check_blocks(
                 dev.tip = d;
                 dev.tip_line = b.line;
             }
+            let da = axis_deviation(&tip, &axis, cl, segs, seg, d, far).to_degrees();
             let (i0, i1) = segs[seg];
             let u = param(&tip, &cl[i0].tip, &cl[i1].tip);
-            let want = slerp(&cl[i0].axis, &cl[i1].axis, u);
-            let da = angle_between(&axis, &want).to_degrees();
             if da > dev.axis_deg {
                 dev.axis_deg = da;
                 dev.axis_line = b.line;
