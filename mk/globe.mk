@@ -63,6 +63,5 @@ $(GLOBE)/coastline.csv: $(GLOBE_COAST) $(GLOBE)/frame.json $(RELEASE)/surf-probe
 $(GLOBE)/coastline-offset.csv: $(GLOBE)/coastline.csv $(RELEASE)/offset
 	$(RELEASE)/offset $< --3d --radius $(GLOBE_TOOL_R) --side left --report $(GLOBE)/coastline-offset.json -o $@
 
-# The axis turns along the coastline's corners: 0.25° of read-back slack for the tool axis.
 $(GLOBE)/globe.ngc: $(GLOBE)/coastline-offset.csv $(GLOBE)/frame.json $(GLOBE_MACHINE) $(RELEASE)/post-6axis
-	$(RELEASE)/post-6axis $< --machine $(GLOBE_MACHINE) --frame $(GLOBE)/frame.json --feed $(GLOBE_FEED) --angle-tol 0.25 --report $(GLOBE)/globe-post.json -o $@
+	$(RELEASE)/post-6axis $< --machine $(GLOBE_MACHINE) --frame $(GLOBE)/frame.json --feed $(GLOBE_FEED) --report $(GLOBE)/globe-post.json -o $@
