@@ -131,7 +131,11 @@ proptest! {
                 let back = chain.forward(s);
                 prop_assert!((back.tip - pose.tip).norm() <= 1e-9, "{name}: tip {:?} vs {:?}", back.tip, pose.tip);
                 prop_assert!(angle(&back.axis, &pose.axis) <= 1e-12, "{name}: axis off by {}", angle(&back.axis, &pose.axis));
-                if (0..n).all(|k| same_angle(s.rot[k], q.rot[k], 1e-9)) && (s.xyz - q.xyz).norm() < 1e-9 {
+                // Joints come back through atan2 of axis components and carry more round-off than
+                // the pose they reproduce (seen: 1.04e-9° on A, hence 3.1e-9 mm on X at 176 mm from
+                // the table centre, for a pose exact to 1e-9 mm and 1e-12 rad): the branch is found
+                // when joints agree to 1e-7° and 1e-7 mm.
+                if (0..n).all(|k| same_angle(s.rot[k], q.rot[k], 1e-7)) && (s.xyz - q.xyz).norm() < 1e-7 {
                     found = true;
                 }
             }
