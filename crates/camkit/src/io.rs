@@ -83,6 +83,11 @@ impl Write for Output {
 /// so readers see the old file or the whole new one.
 pub fn write_atomic(path: &Path, data: &[u8]) -> Result<()> {
     let shown = path.display().to_string();
+    // A device or pipe (`-o /dev/null`, a FIFO) is written in place: renaming over it would
+    // replace the device with a regular file.
+    if std::fs::metadata(path).is_ok_and(|m| !m.is_file() && !m.is_dir()) {
+        return std::fs::write(path, data).map_err(|e| Error::io(e, &shown));
+    }
     let dir = match path.parent() {
         Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
         _ => PathBuf::from("."),
@@ -100,6 +105,13 @@ pub fn write_atomic(path: &Path, data: &[u8]) -> Result<()> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn devices_are_written_in_place_not_replaced() {
+        let null = std::path::Path::new("/dev/null");
+        write_atomic(null, b"x").unwrap();
+        assert!(!std::fs::metadata(null).unwrap().is_file(), "/dev/null was replaced by a file");
+    }
 
     #[test]
     fn output_file_appears_only_on_commit() {
