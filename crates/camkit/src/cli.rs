@@ -1,7 +1,7 @@
 //! What every filter's `main` shares: the program name in messages, exit statuses, the common
 //! input/output/report arguments, warnings, and progress bars that appear only on a terminal.
 
-use crate::error::Result;
+use crate::error::{Error, Result};
 use std::io::IsTerminal;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -37,6 +37,16 @@ pub fn run(name: &'static str, body: impl FnOnce() -> Result<()>) -> ExitCode {
             }
             ExitCode::from(e.exit_status() as u8)
         }
+    }
+}
+
+/// A command-line number that must be finite and above zero (`what` names the option): usage
+/// errors say so in one message shape for every filter.
+pub fn positive(v: f64, what: &str) -> Result<f64> {
+    if v.is_finite() && v > 0.0 {
+        Ok(v)
+    } else {
+        Err(Error::input(format!("{what} must be a positive number, got {v}")))
     }
 }
 

@@ -1,6 +1,6 @@
 //! `curve-fit-arcs`: point streams and G-code to lines and arcs within a proven tolerance.
 
-use camkit::cli::{self, IoArgs};
+use camkit::cli::{self, IoArgs, positive};
 use camkit::error::{Error, Location, Result};
 use camkit::geom::Plane;
 use camkit::io::{Input, Output, write_atomic};
@@ -113,10 +113,7 @@ fn usage(message: String) -> Error {
 }
 
 fn options(args: &Args) -> Result<Options> {
-    let finite_pos = |v: f64, what: &str| {
-        if v.is_finite() && v > 0.0 { Ok(v) } else { Err(usage(format!("{what} must be a positive number, got {v}"))) }
-    };
-    let tol = finite_pos(args.tol, "--tol")?;
+    let tol = positive(args.tol, "--tol")?;
     let planes = match args.plane.as_str() {
         "auto" => vec![Plane::Xy, Plane::Xz, Plane::Yz],
         p => vec![Plane::parse(p).ok_or_else(|| usage(format!("--plane must be xy, xz, yz or auto, got {p}")))?],
@@ -149,9 +146,9 @@ fn options(args: &Args) -> Result<Options> {
         max_radius: args.max_radius,
         max_sweep: args.max_sweep.to_radians(),
         tangent: args.tangent.map(f64::to_radians),
-        corner: finite_pos(args.corner, "--corner")?.to_radians(),
-        curvature_threshold: finite_pos(args.curvature_threshold, "--curvature-threshold")?,
-        e_rate_tol: finite_pos(args.e_rate_tol, "--e-rate-tol")?,
+        corner: positive(args.corner, "--corner")?.to_radians(),
+        curvature_threshold: positive(args.curvature_threshold, "--curvature-threshold")?,
+        e_rate_tol: positive(args.e_rate_tol, "--e-rate-tol")?,
     })
 }
 

@@ -1,6 +1,6 @@
 //! `post-6axis`: CL rows to NC for a machine described in JSON, checked by reading the NC back.
 
-use camkit::cli::{self, IoArgs};
+use camkit::cli::{self, IoArgs, positive};
 use camkit::doc::Frame;
 use camkit::doc::machine::Machine;
 use camkit::error::{Error, Location, Result};
@@ -78,14 +78,6 @@ fn after_help() -> String {
 
 fn main() -> ExitCode {
     cli::run("post-6axis", || run(Args::parse()))
-}
-
-fn positive(v: f64, what: &str) -> Result<f64> {
-    if v.is_finite() && v > 0.0 {
-        Ok(v)
-    } else {
-        Err(Error::input(format!("{what} must be a positive number, got {v}")))
-    }
 }
 
 fn load_machine(args: &Args) -> Result<(Machine, Chain)> {

@@ -1,6 +1,6 @@
 //! `stylus-trace`: copy-simulation CL data on a defined model.
 
-use camkit::cli::{self, IoArgs, Progress};
+use camkit::cli::{self, IoArgs, Progress, positive};
 use camkit::error::{Error, Location, Result};
 use camkit::geom::P3;
 use camkit::io::{Input, Output, write_atomic};
@@ -130,10 +130,6 @@ fn numbers(text: &str, what: &str, n: Option<usize>) -> Result<Vec<f64>> {
         return Err(usage(format!("{what} needs {} numbers, got {text:?}", n.unwrap_or(1))));
     }
     Ok(v)
-}
-
-fn positive(v: f64, what: &str) -> Result<f64> {
-    if v.is_finite() && v > 0.0 { Ok(v) } else { Err(usage(format!("{what} must be a positive number, got {v}"))) }
 }
 
 fn region(args: &Args, model: &Model) -> Result<Region> {

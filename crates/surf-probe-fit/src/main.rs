@@ -1,6 +1,6 @@
 //! `surf-probe-fit`: on-machine measurement of a workpiece's shape and pose (paper 002 §2–4).
 
-use camkit::cli::{self, IoArgs};
+use camkit::cli::{self, IoArgs, positive};
 use camkit::doc::machine::Machine;
 use camkit::error::{Error, Location, Result};
 use camkit::geom::{P3, V3};
@@ -373,14 +373,6 @@ fn main() -> ExitCode {
         Command::Map(a) => run_map(a),
         Command::Surface(a) => run_surface(a),
     })
-}
-
-fn positive(v: f64, what: &str) -> Result<f64> {
-    if v.is_finite() && v > 0.0 {
-        Ok(v)
-    } else {
-        Err(Error::input(format!("{what} must be a positive number, got {v}")))
-    }
 }
 
 /// The chain in table coordinates (frame at zero): the machine's, or a 3-axis machine.
