@@ -8,7 +8,6 @@
 //! re-simulates the whole program and estimates both programs' times ([`feed`]).
 
 pub mod angles;
-pub mod contours;
 pub mod engagement;
 pub mod feed;
 pub mod medial;

@@ -1,9 +1,9 @@
 //! `medial-trochoid`: engagement of contour-parallel pocketing, danger regions on the medial
 //! axis, trochoids first (paper 001).
 
-use camkit::cli::{self, IoArgs};
+use camkit::cli::{self, IoArgs, positive};
 use camkit::contour::Seg;
-use camkit::contour::region::{self, RegionError};
+use camkit::contour::table as contour_table;
 use camkit::error::{Error, Location, Result};
 use camkit::geom::{P2, P3};
 use camkit::io::{Input, Output, write_atomic};
@@ -13,7 +13,7 @@ use clap::{Parser, ValueEnum};
 use medial_trochoid::feed::FeedModel;
 use medial_trochoid::medial::MedialOptions;
 use medial_trochoid::program::Tag;
-use medial_trochoid::{Analysed, Settings, contours, plan, plot};
+use medial_trochoid::{Analysed, Settings, plan, plot};
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Instant;
@@ -120,14 +120,6 @@ fn main() -> ExitCode {
     cli::run("medial-trochoid", || run(Args::parse()))
 }
 
-fn positive(v: f64, what: &str) -> Result<f64> {
-    if v.is_finite() && v > 0.0 {
-        Ok(v)
-    } else {
-        Err(Error::input(format!("{what} must be a positive number, got {v}")))
-    }
-}
-
 fn run(args: Args) -> Result<()> {
     let started = Instant::now();
     let r = positive(args.radius, "--radius")?;
@@ -175,25 +167,11 @@ fn run(args: Args) -> Result<()> {
     if table.rows.is_empty() {
         return Err(Error::input("no rows: no contour to pocket").at(Location::file(&name)));
     }
-    let sources = contours::read(&table, &name)?;
+    let sources = contour_table::read(&table, &name)?.sources;
     if sources.is_empty() {
         return Err(Error::input("no closed contour in the input").at(Location::file(&name)));
     }
-    if let Some(s) = sources.iter().find(|s| (s.z - sources[0].z).abs() > camkit::tol::POINT_EPS) {
-        return Err(
-            Error::input("the contours of a pocket lie at one z").at(Location::file(&name).line(s.line).field("z"))
-        );
-    }
-    let loops: Vec<_> = sources.iter().map(|s| s.contour.clone()).collect();
-    let (regions, _turned) = region::regions(&loops).map_err(|e| {
-        let i = match e {
-            RegionError::Open(i)
-            | RegionError::Degenerate(i)
-            | RegionError::SelfCrossing(i, _)
-            | RegionError::Crossing(i, _, _) => i,
-        };
-        Error::input(format!("path {}: {e}", sources[i].path)).at(Location::file(&name).line(sources[i].line))
-    })?;
+    let (regions, _turned) = contour_table::pocket_regions(&sources, &name)?;
     let plan = plan(&regions, &settings).map_err(|e| match e {
         medial_trochoid::PlanError::Pocket(_) => Error::check(e.to_string()),
         _ => Error::input(e.to_string()).at(Location::file(&name)),

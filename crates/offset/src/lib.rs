@@ -16,14 +16,13 @@ pub mod space;
 
 use camkit::contour::offset::Side;
 use camkit::contour::pocket::{self, Passes, PocketOptions};
-use camkit::contour::region::{self, RegionError};
+use camkit::contour::table::{self as contour_table, Source};
 use camkit::contour::{Contour, OffsetOptions, Seg, offset_contour};
 use camkit::error::{Error, Location, Result};
 use camkit::geom::{P2, P3, Plane, V3};
 use camkit::report::Report;
 use camkit::svg::Plot;
 use camkit::table::{Col, Move, Row, Table};
-use contours::Source;
 
 /// Name of the column holding each pass's offset distance.
 pub const OFFSET_COLUMN: &str = "offset";
@@ -67,13 +66,23 @@ fn push_contour(t: &mut Table, k: usize, c: &Contour, path: i64, z: f64, templat
 }
 
 fn read_sources(table: &Table, name: &str, report: &mut Report) -> Result<Vec<Source>> {
-    let read = contours::read(table, name)?;
+    let read = contour_table::read(table, name).map_err(with_mode_hint)?;
     if read.sources.is_empty() {
         return Err(Error::input("no contour: the table has no pass with two distinct points").at(Location::file(name)));
     }
     report.set("input_contours", read.sources.len()).set("dropped_zero_length_moves", read.dropped);
     report.set("arc_radius_mismatch_mm", read.arc_mismatch);
     Ok(read.sources)
+}
+
+/// A contour that leaves its z or its xy plane may be meant for another mode: say which.
+fn with_mode_hint(mut e: Error) -> Error {
+    match e.location.as_ref().and_then(|l| l.field.as_deref()) {
+        Some("z") => e.message.push_str(" (use --3d for 3D contours)"),
+        Some("plane") => e.message.push_str(" (use --profile for a profile in a vertical plane)"),
+        _ => {}
+    }
+    e
 }
 
 fn self_crossing_error(name: &str, s: &Source, p: P2) -> Error {
@@ -139,29 +148,7 @@ pub fn pocket_mode(table: &Table, name: &str, opts: &PocketOptions) -> Result<Ou
     let mut report = Report::new("offset");
     report.set("mode", "pocket").set("radius_mm", opts.radius).set("step_mm", opts.step);
     let sources = read_sources(table, name, &mut report)?;
-    for s in &sources {
-        if !s.contour.closed {
-            let end = s.contour.vertices.last().map_or(P2::origin(), |v| v.p);
-            return Err(Error::input(format!(
-                "a pocket needs closed contours: path {} ends at ({:.6}, {:.6}), not where it starts (line {})",
-                s.path, end.x, end.y, s.line
-            ))
-            .at(located(name, s.last_line)));
-        }
-    }
-    if let Some(s) = sources.iter().find(|s| (s.z - sources[0].z).abs() > camkit::tol::POINT_EPS) {
-        return Err(Error::input("the contours of a pocket lie at one z").at(located(name, s.line).field("z")));
-    }
-    let loops: Vec<Contour> = sources.iter().map(|s| s.contour.clone()).collect();
-    let (regions, turned) = region::regions(&loops).map_err(|e| {
-        let i = match e {
-            RegionError::Open(i)
-            | RegionError::Degenerate(i)
-            | RegionError::SelfCrossing(i, _)
-            | RegionError::Crossing(i, _, _) => i,
-        };
-        Error::input(format!("path {}: {e}", sources[i].path)).at(located(name, sources[i].line))
-    })?;
+    let (regions, turned) = contour_table::pocket_regions(&sources, name)?;
     let result = pocket::pocket(&regions, opts).map_err(|e| {
         let s = &sources[regions[e.region].outer_source];
         Error::check(format!("pocket of path {} at offset {} mm: {}", s.path, e.distance, e.error))
@@ -197,6 +184,7 @@ pub fn pocket_mode(table: &Table, name: &str, opts: &PocketOptions) -> Result<Ou
         .set("offsets_on_cleaned_input", result.cleaned);
     let title =
         format!("{name}: {} passes, tool radius {} mm, step {} mm", result.passes.len(), opts.radius, opts.step);
+    let loops: Vec<Contour> = sources.iter().map(|s| s.contour.clone()).collect();
     let plot = plot::passes(&title, &loops, &drawn);
     Ok(Outcome { table: out, report, plot, warnings })
 }
@@ -349,7 +337,7 @@ impl Profile {
             rows.push(Row { pos: q, centre, mv, plane: Plane::Xy, ..r.clone() });
         }
         let t = Table { schema: Default::default(), rows };
-        let read = contours::read(&t, name)?;
+        let read = contour_table::read(&t, name)?;
         let Some(src) = read.sources.into_iter().next() else { return Ok(None) };
         let mut contour = src.contour;
         if contour.closed {

@@ -1,6 +1,6 @@
 //! `offset`: gouge-free tool-radius offsets of line/arc contours.
 
-use camkit::cli::{self, IoArgs};
+use camkit::cli::{self, IoArgs, positive};
 use camkit::contour::OffsetOptions;
 use camkit::contour::offset::Side;
 use camkit::contour::pocket::{Direction, PocketOptions};
@@ -156,14 +156,6 @@ fn after_help() -> String {
 
 fn main() -> ExitCode {
     cli::run("offset", || run(Args::parse()))
-}
-
-fn positive(v: f64, what: &str) -> Result<f64> {
-    if v.is_finite() && v > 0.0 {
-        Ok(v)
-    } else {
-        Err(Error::input(format!("{what} must be a positive number of mm, got {v}")))
-    }
 }
 
 fn side(args: &Args, needed: bool) -> Result<Side> {

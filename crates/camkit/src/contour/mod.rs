@@ -11,6 +11,7 @@
 pub mod offset;
 pub mod pocket;
 pub mod region;
+pub mod table;
 mod verify;
 
 pub use offset::{Offset, OffsetError, OffsetOptions, offset_contour, offset_region};
