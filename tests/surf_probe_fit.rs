@@ -201,3 +201,50 @@ fn free_form_height_field_from_the_raster() {
     w.run(BIN, &["surface", "rec.csv", "--net", "30,30", "-o", "x.json"], b"")
         .fails(2, "a 30x30 net needs at least 900");
 }
+
+#[test]
+fn ransac_drops_gross_outliers_reproducibly() {
+    let w = Work::new();
+    let args = ["reference", "--centre", "3.2,-1.7,40.5", "--extent", "90", "--points", "200", "--amplitude", "0.002"];
+    w.run(BIN, &[&args[..], &["-o", "pts.csv"]].concat(), b"").ok();
+    // 100 gross outliers (a third of the points): chips 0.5-2.5 mm above the sphere.
+    let mut text = w.read("pts.csv");
+    for k in 0..100 {
+        let (t, p) = (0.015 * k as f64, 0.37 * k as f64);
+        let r = 25.0 + 0.5 + 0.02 * k as f64;
+        let (x, y, z) = (3.2 + r * t.sin() * p.cos(), -1.7 + r * t.sin() * p.sin(), 40.5 + r * t.cos());
+        text.push_str(&format!("{x},{y},{z}\n"));
+    }
+    w.write("dirty.csv", text);
+    let fit = ["fit", "dirty.csv", "--robust", "ransac", "--seed", "3"];
+    w.run(BIN, &[&fit[..], &["-o", "a.json", "--report", "r.json"]].concat(), b"").ok();
+    w.run(BIN, &[&fit[..], &["-o", "b.json"]].concat(), b"").ok();
+    assert_eq!(w.read("a.json"), w.read("b.json"), "the same seed gives the same frame");
+    let r = json(&w, "r.json");
+    assert_eq!(r["outliers"], 100, "{r}");
+    assert_eq!(r["inliers"], 200, "{r}");
+    assert_eq!(r["robust"]["method"], "ransac");
+    let t = r["threshold_mm"].as_f64().unwrap();
+    assert!(t > 0.002 && t < 0.5, "{r}");
+    // The outliers are the last 100 rows: lines 202.. (header line 1).
+    assert_eq!(r["outlier_lines"].as_array().unwrap().len(), 20);
+    assert_eq!(r["outlier_lines"][0], 202, "{r}");
+    let centre = |j: &serde_json::Value| -> Vec<f64> {
+        j["fit"]["centre"].as_array().unwrap().iter().map(|x| x.as_f64().unwrap()).collect()
+    };
+    let off = |c: &[f64]| ((c[0] - 3.2).powi(2) + (c[1] + 1.7).powi(2) + (c[2] - 40.5).powi(2)).sqrt();
+    let robust = json(&w, "a.json");
+    assert!(off(&centre(&robust)) < 1e-7, "{robust}");
+    assert!((robust["fit"]["radius"].as_f64().unwrap() - 25.0).abs() < 1e-7);
+    w.run(BIN, &["fit", "dirty.csv", "-o", "plain.json"], b"").ok();
+    assert!(off(&centre(&json(&w, "plain.json"))) > 0.05, "the plain fit is pulled off");
+    // A given threshold, and bad settings.
+    w.run(BIN, &[&fit[..], &["--ransac-threshold", "0.1", "--report", "g.json", "-o", "g.json.out"]].concat(), b"")
+        .ok();
+    assert_eq!(json(&w, "g.json")["threshold_mm"], 0.1);
+    w.run(BIN, &[&fit[..], &["--confidence", "1", "-o", "x.json"]].concat(), b"").fails(2, "--confidence");
+    w.run(BIN, &[&fit[..], &["--ransac-threshold", "-1", "-o", "x.json"]].concat(), b"").fails(2, "--ransac-threshold");
+    w.write("four.csv", "x,y,z\n0,0,0\n1,1,1\n2,4,8\n3,9,27\n");
+    w.run(BIN, &["fit", "four.csv", "--robust", "ransac", "-o", "x.json"], b"").fails(2, "sample of 4");
+    assert!(!w.exists("x.json"), "no partial output");
+}

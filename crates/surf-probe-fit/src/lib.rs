@@ -12,6 +12,7 @@ pub mod frame;
 pub mod globe;
 pub mod heightfield;
 pub mod lsq;
+pub mod ransac;
 pub mod records;
 pub mod reference;
 pub mod rng;
@@ -19,4 +20,5 @@ pub mod rough;
 pub mod sensor;
 pub mod shapes;
 
+pub use ransac::Ransac;
 pub use shapes::{Fit, FitError, Kind, Options, Robust, Shape, fit};

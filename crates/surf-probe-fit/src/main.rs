@@ -18,7 +18,7 @@ use surf_probe_fit::reference::{self, Spec};
 use surf_probe_fit::rng::Rng;
 use surf_probe_fit::rough::{self, Probe};
 use surf_probe_fit::sensor::Sensor;
-use surf_probe_fit::{FitError, Kind, Options, Robust, Shape, frame, globe, heightfield, shapes};
+use surf_probe_fit::{FitError, Kind, Options, Ransac, Robust, Shape, frame, globe, heightfield, shapes};
 
 #[derive(Parser, Debug)]
 #[command(
@@ -97,6 +97,8 @@ enum RobustArg {
     None,
     /// Huber weights (iteratively reweighted).
     Huber,
+    /// RANSAC on minimal samples, then least squares on the inliers.
+    Ransac,
 }
 
 #[derive(clap::Args, Debug)]
@@ -116,6 +118,19 @@ struct FitArgs {
     /// Huber threshold in robust standard deviations.
     #[arg(long, default_value_t = 1.345, value_name = "K")]
     huber_k: f64,
+    /// RANSAC inlier threshold on the orthogonal distance (mm); default 2.5 robust standard
+    /// deviations of the best hypothesis (least median of squares).
+    #[arg(long, value_name = "MM")]
+    ransac_threshold: Option<f64>,
+    /// RANSAC: wanted probability that some sample is free of outliers (sets the number of samples).
+    #[arg(long, default_value_t = Ransac::default().confidence, value_name = "P")]
+    confidence: f64,
+    /// RANSAC: seed of the samples (the same seed gives the same fit).
+    #[arg(long, default_value_t = Ransac::default().seed)]
+    seed: u64,
+    /// RANSAC: most samples drawn.
+    #[arg(long, default_value_t = Ransac::default().max_hypotheses, value_name = "N")]
+    max_hypotheses: usize,
     /// Noise amplification above which a parameter is reported as poorly determined.
     #[arg(long, default_value_t = shapes::DEFAULT_MAX_AMPLIFICATION, value_name = "FACTOR")]
     max_amplification: f64,
@@ -460,6 +475,20 @@ fn run_fit(args: FitArgs) -> Result<()> {
         robust: match args.robust {
             RobustArg::None => Robust::None,
             RobustArg::Huber => Robust::Huber(positive(args.huber_k, "--huber-k")?),
+            RobustArg::Ransac => {
+                if !(args.confidence > 0.0 && args.confidence < 1.0) {
+                    return Err(Error::input("--confidence must be between 0 and 1 (exclusive)"));
+                }
+                if args.max_hypotheses == 0 {
+                    return Err(Error::input("--max-hypotheses must be at least 1"));
+                }
+                Robust::Ransac(Ransac {
+                    threshold: args.ransac_threshold.map(|t| positive(t, "--ransac-threshold")).transpose()?,
+                    confidence: args.confidence,
+                    seed: args.seed,
+                    max_hypotheses: args.max_hypotheses,
+                })
+            }
         },
     };
     let truth = args.truth.as_deref().map(read_shape).transpose()?;
@@ -492,6 +521,18 @@ fn run_fit(args: FitArgs) -> Result<()> {
         .set("parameters", &f.parameters)
         .set("poorly_determined", &f.poorly_determined)
         .set("frame", [doc.xc, doc.yc, doc.za]);
+    if let Some(r) = &f.robust {
+        report.set("robust", r);
+        if r.method == "ransac" {
+            let lines: Vec<u64> = r.outlier_indices.iter().take(OUTLIER_LINES).map(|&k| t.rows[k].line).collect();
+            report
+                .set("inliers", r.inliers)
+                .set("outliers", r.outliers)
+                .set("threshold_mm", r.threshold)
+                .set("hypotheses", r.hypotheses)
+                .set("outlier_lines", lines);
+        }
+    }
     if let Some(truth) = &truth {
         truth_keys(&mut report, &f.shape, truth);
     }
@@ -501,6 +542,9 @@ fn run_fit(args: FitArgs) -> Result<()> {
     }
     out.commit()
 }
+
+/// Outlier lines named in the report (the first ones).
+const OUTLIER_LINES: usize = 20;
 
 /// Errors of the fitted element against the true one, in the report.
 fn truth_keys(report: &mut Report, got: &Shape, truth: &Shape) {

@@ -1,9 +1,11 @@
 //! Geometric fits of a sphere, a plane, a circle and a cylinder: an algebraic (linear) start,
 //! then least squares on orthogonal distances ([`crate::lsq`]), optionally robust (Huber weights
-//! by iteratively reweighted least squares), with RMS, the largest residual, each parameter's
+//! by iteratively reweighted least squares, or RANSAC and a refit of the inliers:
+//! [`crate::ransac`]), with RMS, the largest residual, each parameter's
 //! standard uncertainty and a warning for parameters the points determine poorly.
 
 use crate::lsq::{self, Failure, Problem};
+use crate::ransac::{self, Ransac};
 use camkit::geom::{P3, V3};
 use nalgebra::{Matrix3, Matrix4, SVector, SymmetricEigen, Vector4};
 use serde::{Deserialize, Serialize};
@@ -123,6 +125,8 @@ pub enum Robust {
     None,
     /// Huber weights with threshold `k` robust standard deviations (1.345 is the usual choice).
     Huber(f64),
+    /// RANSAC on minimal samples, then least squares on the inliers.
+    Ransac(Ransac),
 }
 
 /// Settings of a fit.
@@ -159,17 +163,57 @@ pub struct Param {
     pub amplification: f64,
 }
 
-/// Robust weighting figures.
+/// Robust fitting figures.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct RobustInfo {
-    /// `huber`.
+    /// `huber` or `ransac`.
     pub method: &'static str,
-    /// Robust standard deviation of the residuals (1.4826 × median absolute residual, mm).
+    /// Robust standard deviation of the residuals (1.4826 × median absolute residual, mm; RANSAC:
+    /// of the inliers from the final fit).
     pub scale: f64,
-    /// Points given a weight below 1.
+    /// Points given a weight below 1 (RANSAC: the outliers, weight 0).
     pub downweighted: usize,
-    /// Reweighting rounds.
+    /// Reweighting rounds (RANSAC: refit-and-reclassify rounds).
     pub rounds: usize,
+    /// RANSAC: the inlier threshold on the distance (mm), given or from the robust scale.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub threshold: Option<f64>,
+    /// RANSAC: points within the threshold of the final fit (the points it was fitted to).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub inliers: Option<usize>,
+    /// RANSAC: the other points.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub outliers: Option<usize>,
+    /// RANSAC: hypotheses drawn (degenerate samples included).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub hypotheses: Option<usize>,
+    /// RANSAC: points per sample.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub sample_size: Option<usize>,
+    /// RANSAC: seed of the samples.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub seed: Option<u64>,
+    /// RANSAC: indices (0-based, ascending) of the outliers in the input (not in the document).
+    #[serde(skip)]
+    pub outlier_indices: Vec<usize>,
+}
+
+impl RobustInfo {
+    fn huber(scale: f64, downweighted: usize, rounds: usize) -> RobustInfo {
+        RobustInfo {
+            method: "huber",
+            scale,
+            downweighted,
+            rounds,
+            threshold: None,
+            inliers: None,
+            outliers: None,
+            hypotheses: None,
+            sample_size: None,
+            seed: None,
+            outlier_indices: Vec::new(),
+        }
+    }
 }
 
 /// A fit and its figures.
@@ -178,7 +222,7 @@ pub struct Fit {
     /// The element.
     #[serde(flatten)]
     pub shape: Shape,
-    /// Number of points.
+    /// Number of points fitted (RANSAC: the inliers).
     pub points: usize,
     /// Root mean square of the orthogonal distances (mm).
     pub rms: f64,
@@ -262,6 +306,9 @@ pub fn fit(kind: Kind, points: &[P3], opts: &Options) -> Result<Fit, FitError> {
     if line {
         return Err(FitError::Undetermined(format!("all points lie on one line: a {} is not determined", kind.name())));
     }
+    if let Robust::Ransac(r) = opts.robust {
+        return ransac::fit(kind, points, opts, &r, DIVERGENCE_FACTOR * spread.sigma[2]);
+    }
     match kind {
         Kind::Sphere if flat => {
             Err(FitError::Undetermined("all points lie on one plane: a sphere is not determined".into()))
@@ -340,7 +387,7 @@ fn solve<const N: usize, P: Problem<N>>(
     let Robust::Huber(k) = robust else { return Ok((sol, None)) };
     let mut iterations = sol.iterations;
     let mut weights = vec![1.0; points.len()];
-    let mut info = RobustInfo { method: "huber", scale: 0.0, downweighted: 0, rounds: 0 };
+    let mut info = RobustInfo::huber(0.0, 0, 0);
     for round in 1..=HUBER_ROUNDS {
         let res: Vec<f64> = points.iter().map(|x| problem.eval(&sol.state, x).0).collect();
         let mut abs: Vec<f64> = res.iter().map(|r| r.abs()).collect();
@@ -353,12 +400,7 @@ fn solve<const N: usize, P: Problem<N>>(
             change = change.max((nw - *w).abs());
             *w = nw;
         }
-        info = RobustInfo {
-            method: "huber",
-            scale,
-            downweighted: weights.iter().filter(|&&w| w < 1.0).count(),
-            rounds: round,
-        };
+        info = RobustInfo::huber(scale, weights.iter().filter(|&&w| w < 1.0).count(), round);
         if change <= HUBER_WEIGHT_TOL && round > 1 {
             break;
         }
