@@ -1,8 +1,9 @@
 //! End-to-end tests of `surf-probe-fit`: the globe measurement (3-axis raster, rough Delaunay
 //! surface, 5-axis plan along its normals on paper 002's A/C machine, simulated sensor, fit)
 //! with the 5-axis fit beating the 3-axis one against the known sphere; the plan and the frame
-//! accepted by `post-6axis`; reference sets reproduced through CSV; bad input refused with one
-//! line and no output file.
+//! accepted by `post-6axis`; the coastline on a fitted frame posted and read back by `post-6axis`;
+//! reference sets reproduced through CSV; RANSAC against gross outliers; bad input refused with
+//! one line and no output file.
 
 use e2e::{Work, data};
 
@@ -152,10 +153,27 @@ fn bad_input_is_refused() {
         })
         .collect();
     w.write("bulge.csv", format!("x,y,z\n{bulge}"));
-    let o = w.run(BIN, &["fit", "bulge.csv", "-o", "out.json"], b"");
+    let o = w.run(BIN, &["fit", "bulge.csv", "-o", "out.json", "--report", "r.json"], b"");
     assert_eq!(o.status, 1, "{}", o.stderr);
+    assert!(o.stderr.contains("radius ran off"), "{}", o.stderr);
     assert_eq!(o.stderr.trim_end().lines().count(), 1, "{}", o.stderr);
-    assert!(!w.exists("out.json"), "no partial output");
+    // Fewer points than parameters for the other elements; the same refusals with RANSAC.
+    w.write(
+        "two.csv",
+        "x,y,z
+0,0,0
+1,0,0
+",
+    );
+    w.run(BIN, &["fit", "two.csv", "--shape", "plane", "-o", "out.json"], b"").fails(2, "a plane needs at least 3");
+    w.run(BIN, &["fit", "three.csv", "--shape", "cylinder", "-o", "out.json"], b"")
+        .fails(2, "a cylinder needs at least 5");
+    w.run(BIN, &["fit", "flat.csv", "--robust", "ransac", "-o", "out.json"], b"")
+        .fails(2, "all points lie on one plane");
+    w.run(BIN, &["fit", "nan.csv", "--robust", "ransac", "-o", "out.json"], b"").fails(2, "nan.csv:3");
+    w.run(BIN, &["fit", "dup.csv", "--robust", "huber", "-o", "out.json"], b"").fails(2, "duplicate point");
+    // Every refusal above wrote to out.json (and the failed fit its report): none exists.
+    assert!(!w.exists("out.json") && !w.exists("r.json"), "no partial output");
 }
 
 #[test]
@@ -179,9 +197,21 @@ fn coastline_on_the_fitted_sphere_is_offset_normal_to_the_tool_axis() {
     }
     assert!(rows > 100);
     w.run("offset", &["coast.csv", "--3d", "--radius", "1.5", "--side", "left", "-o", "off.csv"], b"").ok();
-    // (post-6axis turns this into NC in the globe demo; on this reference frame its read-back
-    // finds one offset row 0.94 mm from the program: reported to its owner, not asserted here.)
     assert!(w.read("off.csv").lines().count() > 100);
+    // NC for the A/C table machine on the fitted frame; post-6axis reads its program back.
+    let machine = d("post-6axis/paper002-ac.json");
+    let post = ["off.csv", "-m", &machine, "--frame", "frame.json", "--feed", "300"];
+    w.run("post-6axis", &[&post[..], &["-o", "coast.ngc", "--report", "post.json"]].concat(), b"").ok();
+    let p = json(&w, "post.json");
+    let tol = p["tol_mm"].as_f64().unwrap();
+    assert!(p["largest_tip_deviation_mm"].as_f64().unwrap() <= tol, "{p}");
+    assert!(p["largest_row_distance_mm"].as_f64().unwrap() <= tol, "{p}");
+    assert!(p["largest_axis_deviation_deg"].as_f64().unwrap() <= p["angle_tol_deg"].as_f64().unwrap(), "{p}");
+    assert_eq!(p["dropped_blocks"], 0, "{p}");
+    assert!(p["blocks_checked"].as_u64().unwrap() > 100, "{p}");
+    w.run("post-6axis", &[&post[..], &["--verify", "coast.ngc", "-o", "verify.json"]].concat(), b"").ok();
+    let v = json(&w, "verify.json");
+    assert!(v["largest_tip_deviation_mm"].as_f64().unwrap() <= tol, "{v}");
     w.write("bad.json", r#"{"parts": [[[140, 40]]]}"#);
     w.run(BIN, &["map", "bad.json", "--frame", "frame.json", "-o", "x.csv"], b"").fails(2, "parts[0]");
 }

@@ -212,8 +212,9 @@ pub fn fit(kind: Kind, points: &[P3], opts: &Options, r: &Ransac, largest_radius
     let mut drawn = 0usize;
     let mut wanted = r.max_hypotheses as f64;
     while (drawn as f64) < wanted.min(r.max_hypotheses as f64) {
-        let samples: Vec<Vec<usize>> = (0..BATCH).map(|_| draw(&mut rng, n, s)).collect();
-        drawn += BATCH;
+        let batch = BATCH.min(r.max_hypotheses - drawn);
+        let samples: Vec<Vec<usize>> = (0..batch).map(|_| draw(&mut rng, n, s)).collect();
+        drawn += batch;
         let scored: Vec<Option<Scored>> = samples
             .par_iter()
             .map(|idx| {

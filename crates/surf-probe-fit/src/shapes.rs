@@ -306,16 +306,16 @@ pub fn fit(kind: Kind, points: &[P3], opts: &Options) -> Result<Fit, FitError> {
     if line {
         return Err(FitError::Undetermined(format!("all points lie on one line: a {} is not determined", kind.name())));
     }
+    if flat && matches!(kind, Kind::Sphere | Kind::Cylinder) {
+        return Err(FitError::Undetermined(format!(
+            "all points lie on one plane: a {} is not determined",
+            kind.name()
+        )));
+    }
     if let Robust::Ransac(r) = opts.robust {
         return ransac::fit(kind, points, opts, &r, DIVERGENCE_FACTOR * spread.sigma[2]);
     }
     match kind {
-        Kind::Sphere if flat => {
-            Err(FitError::Undetermined("all points lie on one plane: a sphere is not determined".into()))
-        }
-        Kind::Cylinder if flat => {
-            Err(FitError::Undetermined("all points lie on one plane: a cylinder is not determined".into()))
-        }
         Kind::Sphere => fit_sphere(points, opts, &spread),
         Kind::Plane => fit_plane(points, opts, &spread),
         Kind::Circle => fit_circle(points, opts, &spread),
