@@ -227,6 +227,9 @@ fn free_form_height_field_from_the_raster() {
     w.run(BIN, &["surface", "rec.csv", "--net", "8,8", "-o", "model.json", "--report", "s.json"], b"").ok();
     let r = json(&w, "s.json");
     assert!(r["rms_mm"].as_f64().unwrap() < 0.002, "{r}");
+    let (ortho, vertical) = (r["orthogonal_rms_mm"].as_f64().unwrap(), r["rms_mm"].as_f64().unwrap());
+    assert!(ortho > 0.0 && ortho <= vertical, "{r}");
+    assert!(r["largest_orthogonal_mm"].as_f64().unwrap().abs() <= r["largest_residual_mm"].as_f64().unwrap().abs());
     assert_eq!(json(&w, "model.json")["surfaces"][0]["control_points"].as_array().unwrap().len(), 8);
     w.run(BIN, &["surface", "rec.csv", "--net", "30,30", "-o", "x.json"], b"")
         .fails(2, "a 30x30 net needs at least 900");

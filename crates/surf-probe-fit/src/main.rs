@@ -307,7 +307,9 @@ fn run_surface(args: SurfaceArgs) -> Result<()> {
         .set("points", pts.len())
         .set("net", &args.net)
         .set("rms_mm", h.rms)
-        .set("largest_residual_mm", h.largest_residual);
+        .set("largest_residual_mm", h.largest_residual)
+        .set("orthogonal_rms_mm", h.orthogonal_rms)
+        .set("largest_orthogonal_mm", h.largest_orthogonal);
     if let Some(path) = &args.io.report {
         report.write(path)?;
     }
