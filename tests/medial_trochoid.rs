@@ -105,3 +105,48 @@ fn bad_input_is_refused_with_its_place() {
     assert_eq!(out.status, 2, "{}", out.stderr);
     assert!(!w.exists("never.csv"));
 }
+
+#[test]
+fn wall_pass_corners_are_rounded_and_their_rest_named() {
+    let w = Work::new();
+    let src = data("medial-trochoid/square.csv");
+    let sq = src.to_str().unwrap();
+    // Sharp corners: the wall pass meets the corner's whole quadrant (≥ 90°).
+    w.run(BIN, &[sq, "--radius", "5", "--corner-radius", "0", "--report", "s.json", "-o", "s.csv"], b"").ok();
+    let s = report(&w, "s.json");
+    assert!(s["largest_engagement_deg"].as_f64().unwrap() >= 90.0, "{s}");
+    assert_eq!(s["corner_rests"], 0);
+    // A given radius: four rests at the pocket's corners, r = R + ρ, thickness r(√2 − 1) and
+    // area r²(1 − π/4) for the 90° corners.
+    let args = [sq, "--radius", "5", "--corner-radius", "2", "--derate", "0.5", "--report", "r.json", "-o", "t.csv"];
+    w.run(BIN, &args, b"").ok();
+    let r = report(&w, "r.json");
+    assert_eq!(r["corner_rests"], 4);
+    let at: Vec<(f64, f64)> = r["corner_rest_at_mm"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|p| (p[0].as_f64().unwrap(), p[1].as_f64().unwrap()))
+        .collect();
+    for (x, y) in &at {
+        let near = |v: f64, a: f64, b: f64| (v - a).abs() < 1e-9 || (v - b).abs() < 1e-9;
+        assert!(near(*x, 0.0, 60.0) && near(*y, 0.0, 40.0), "rest at ({x}, {y})");
+    }
+    for k in 0..4 {
+        assert!((r["corner_radii_mm"][k].as_f64().unwrap() - 2.0).abs() < 1e-12);
+        let t = r["corner_rest_thickness_mm"][k].as_f64().unwrap();
+        assert!((t - 7.0 * (2f64.sqrt() - 1.0)).abs() < 1e-9, "{t}");
+        let a = r["corner_rest_area_mm2"][k].as_f64().unwrap();
+        assert!((a - 49.0 * (1.0 - std::f64::consts::FRAC_PI_4)).abs() < 1e-9, "{a}");
+    }
+    // The rounded program leaves the walls alone.
+    assert_eq!(r["no_gouge"], true);
+    // Derating: every kind of move of the offset-only program has a worst engagement over the
+    // threshold, so at one feed per kind it takes exactly twice as long at a factor of 0.5.
+    let f = |k: &str| r[k].as_f64().unwrap_or_else(|| panic!("{k} in {r}"));
+    assert!((f("offset_only_minutes") - 2.0 * f("offset_only_underated_minutes")).abs() < 1e-9);
+    assert!(f("trochoidal_minutes") > f("trochoidal_underated_minutes"));
+    assert!(f("time_ratio") < f("time_ratio_underated"));
+    w.run(BIN, &[sq, "--radius", "5", "--derate", "1.5"], b"").fails(2, "--derate");
+    w.run(BIN, &[sq, "--radius", "5", "--corner-radius", "-1"], b"").fails(2, "--corner-radius");
+}

@@ -127,6 +127,37 @@ impl Cut {
         (TAU - all.iter().map(|(a, b)| b - a).sum::<f64>()).max(0.0)
     }
 
+    /// Engagement (radians) at fraction `t` of `extra[k]`, pieces cut after all of `self`:
+    /// the part of the tool circle not removed by `self`, `extra[..k]` and `extra[k]` up to `t`.
+    pub fn engagement_after(&self, extra: &[Seg], k: usize, t: f64) -> f64 {
+        let r = self.radius;
+        let p = extra[k].point_at(t);
+        let (x0, y0) = key(self.cell, &P2::new(p.x - r, p.y - r));
+        let (x1, y1) = key(self.cell, &P2::new(p.x + r, p.y + r));
+        let mut near: Vec<usize> = Vec::new();
+        for x in x0..=x1 {
+            for y in y0..=y1 {
+                if let Some(v) = self.grid.get(&(x, y)) {
+                    near.extend(v.iter().copied());
+                }
+            }
+        }
+        near.sort_unstable();
+        near.dedup();
+        let mut all: Vec<(f64, f64)> = Vec::new();
+        for j in near {
+            all.extend(removed_by(&p, r, &self.pieces[j]).0);
+        }
+        for e in &extra[..k] {
+            all.extend(removed_by(&p, r, e).0);
+        }
+        if t > 0.0 {
+            all.extend(removed_by(&p, r, &extra[k].sub(0.0, t)).0);
+        }
+        merge(&mut all);
+        (TAU - all.iter().map(|(a, b)| b - a).sum::<f64>()).max(0.0)
+    }
+
     /// Sample positions along every piece: fractions at most `step` mm apart, the piece's end
     /// always included (corners are where engagement peaks). Returns (piece, fraction) pairs.
     pub fn samples(&self, step: f64) -> Vec<(usize, f64)> {

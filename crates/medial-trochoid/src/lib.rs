@@ -8,6 +8,7 @@
 //! re-simulates the whole program and estimates both programs' times ([`feed`]).
 
 pub mod angles;
+pub mod corner;
 pub mod engagement;
 pub mod feed;
 pub mod medial;
@@ -41,6 +42,10 @@ pub struct Settings {
     pub pitch: Option<f64>,
     /// Material left on the walls (mm).
     pub allowance: f64,
+    /// Radius of the tangent arcs that replace the wall passes' sharp inside corners (mm);
+    /// `None` fits each corner by simulation (the smallest of [`CORNER_RADII`] that holds the
+    /// threshold).
+    pub corner_radius: Option<f64>,
     /// Engagement sample spacing along the path (mm).
     pub sample: f64,
     /// Medial axis settings.
@@ -66,12 +71,18 @@ pub struct Analysed {
     pub max_link: f64,
     /// Samples of cutting moves (trochoids and passes) over the threshold.
     pub over: usize,
+    /// Samples of links over the threshold.
+    pub over_links: usize,
     /// Largest engagement over entries.
     pub max_entry: f64,
     /// Machining time of the layer (min) with the feed following the engagement sample by sample.
     pub minutes: f64,
     /// Machining time of the layer (min) with each kind of move at the feed its worst engagement allows.
     pub minutes_constant: f64,
+    /// [`Analysed::minutes`] under the feed model without its derating.
+    pub minutes_underated: f64,
+    /// [`Analysed::minutes_constant`] under the feed model without its derating.
+    pub minutes_constant_underated: f64,
     /// Smallest distance from the tool centre to the walls (mm).
     pub wall_clearance: f64,
 }
@@ -97,11 +108,14 @@ pub struct Plan {
     pub uncleared: Vec<Vec<P2>>,
     /// Samples of the offset-only program over the threshold.
     pub danger_samples: usize,
+    /// Rest material at the wall passes' rounded inside corners, left to finishing.
+    pub rests: Vec<corner::Rest>,
 }
 
 /// Round-off of a computed engagement (degrees): a side cut at exactly the threshold's step
-/// over computes to the threshold within this.
-pub const ENGAGEMENT_ROUNDOFF_DEG: f64 = 1e-6;
+/// over computes to the threshold within this (measured: 1.2e-6° where a rounded corner's
+/// line meets the previous pass's band tangentially).
+pub const ENGAGEMENT_ROUNDOFF_DEG: f64 = 1e-5;
 
 /// How many loop radii a plan tries: the given one and its halvings.
 const LEVELS: usize = 5;
@@ -164,25 +178,14 @@ pub fn analyse(program: Program, s: &Settings, regions: &[Region]) -> Analysed {
             matches!(program.moves[*i].tag, Tag::Trochoid | Tag::Contour) && **e > s.threshold + ENGAGEMENT_ROUNDOFF_DEG
         })
         .count();
-    // Two feed strategies: every sample at the feed its own engagement allows (the larger of
-    // the engagements at its two ends; air at the tool's largest feed per tooth), and each kind
-    // of move at one feed, the one its worst engagement allows. Entries ramp at the slot feed.
-    let mut feeds = Vec::with_capacity(samples.len());
-    let (mut minutes, mut minutes_constant) = (0.0, 0.0);
-    let mut before = (usize::MAX, 0.0, 0.0);
-    for (&(i, t), &e) in samples.iter().zip(&engagement) {
-        let m = &program.moves[i];
-        let (t0, e0) = if before.0 == i { (before.1, before.2) } else { (0.0, e) };
-        let (f, fc) = match m.tag {
-            Tag::Entry => (s.feed.feed(180.0), s.feed.feed(180.0)),
-            t => (s.feed.feed(e.max(e0)), s.feed.feed(get(t))),
-        };
-        let len = m.seg.length() * (t - t0);
-        minutes += len / f;
-        minutes_constant += len / fc;
-        feeds.push(f);
-        before = (i, t, e);
-    }
+    let over_links = samples
+        .iter()
+        .zip(&engagement)
+        .filter(|((i, _), e)| program.moves[*i].tag == Tag::Link && **e > s.threshold + ENGAGEMENT_ROUNDOFF_DEG)
+        .count();
+    let (feeds, minutes, minutes_constant) = times(&program, &samples, &engagement, &get, &s.feed);
+    let (_, minutes_underated, minutes_constant_underated) =
+        times(&program, &samples, &engagement, &get, &s.feed.underated());
     let wall_clearance = program
         .moves
         .iter()
@@ -196,11 +199,44 @@ pub fn analyse(program: Program, s: &Settings, regions: &[Region]) -> Analysed {
         max_cutting,
         max_link: get(Tag::Link),
         over,
+        over_links,
         max_entry: get(Tag::Entry),
         minutes,
         minutes_constant,
+        minutes_underated,
+        minutes_constant_underated,
         wall_clearance,
     }
+}
+
+/// Feeds per sample and the layer's minutes under `model` for two feed strategies: every sample
+/// at the feed its own engagement allows (the larger of the engagements at its two ends; air at
+/// the tool's largest feed per tooth), and each kind of move at one feed, the one its worst
+/// engagement (`worst`) allows. Entries ramp at the slot feed.
+fn times(
+    program: &Program,
+    samples: &[(usize, f64)],
+    engagement: &[f64],
+    worst: &dyn Fn(Tag) -> f64,
+    model: &FeedModel,
+) -> (Vec<f64>, f64, f64) {
+    let mut feeds = Vec::with_capacity(samples.len());
+    let (mut minutes, mut minutes_constant) = (0.0, 0.0);
+    let mut before = (usize::MAX, 0.0, 0.0);
+    for (&(i, t), &e) in samples.iter().zip(engagement) {
+        let m = &program.moves[i];
+        let (t0, e0) = if before.0 == i { (before.1, before.2) } else { (0.0, e) };
+        let (f, fc) = match m.tag {
+            Tag::Entry => (model.feed(180.0), model.feed(180.0)),
+            t => (model.feed(e.max(e0)), model.feed(worst(t))),
+        };
+        let len = m.seg.length() * (t - t0);
+        minutes += len / f;
+        minutes_constant += len / fc;
+        feeds.push(f);
+        before = (i, t, e);
+    }
+    (feeds, minutes, minutes_constant)
 }
 
 /// The offset-only and the trochoids-first programs of `regions`.
@@ -282,9 +318,10 @@ pub fn plan(regions: &[Region], s: &Settings) -> Result<Plan, PlanError> {
     for run in &runs {
         trochoid::push_trochoids(&mut troch, &run.points, run.radius, run.pitch);
     }
+    let (passes, rests) = round_walls(&pocket.passes, &troch, s);
     let mut first = true;
     for (ri, region) in regions.iter().enumerate() {
-        let mine: Vec<Pass> = pocket.passes.iter().filter(|p| p.region == ri).cloned().collect();
+        let mine: Vec<Pass> = passes.iter().filter(|p| p.region == ri).cloned().collect();
         if first && !troch.moves.is_empty() {
             // Start the passes with a retract: the trochoids end somewhere in the pocket.
             let mut rest = Program::default();
@@ -301,7 +338,7 @@ pub fn plan(regions: &[Region], s: &Settings) -> Result<Plan, PlanError> {
     let trochoidal = analyse(troch, s, regions);
     Ok(Plan {
         regions: regions.to_vec(),
-        passes: pocket.passes,
+        passes,
         medial,
         offset_only,
         trochoidal,
@@ -309,7 +346,61 @@ pub fn plan(regions: &[Region], s: &Settings) -> Result<Plan, PlanError> {
         runs,
         uncleared,
         danger_samples: hot.len(),
+        rests,
     })
+}
+
+/// Corner radii (mm) tried, smallest first, when the wall passes' corners are fitted by
+/// simulation.
+pub const CORNER_RADII: [f64; 18] =
+    [0.25, 0.5, 0.75, 1.0, 1.25, 1.5, 1.75, 2.0, 2.25, 2.5, 2.75, 3.0, 3.5, 4.0, 5.0, 6.0, 7.0, 8.0];
+
+/// The passes with the wall passes' (level 0) sharp inside corners rounded, and the rest each
+/// rounded corner leaves. Each corner's radius is the given one, or the smallest of
+/// [`CORNER_RADII`] whose simulated engagement (after the trochoids and every inner pass) stays
+/// at or under the threshold; where none does, the one with the lowest engagement (and the
+/// whole-program check reports it).
+fn round_walls(passes: &[Pass], troch: &Program, s: &Settings) -> (Vec<Pass>, Vec<corner::Rest>) {
+    let mut before: Vec<camkit::contour::Seg> = troch.moves.iter().map(|m| m.seg).collect();
+    let is_wall = |p: &Pass| p.level == 0 && !p.clean_up;
+    for p in passes.iter().filter(|p| !is_wall(p)) {
+        before.extend(p.contour.segs());
+    }
+    let base = Cut::new(s.radius, before);
+    let limit = s.threshold + ENGAGEMENT_ROUNDOFF_DEG;
+    let step = s.sample.min(0.25);
+    let mut rests = Vec::new();
+    let out = passes
+        .iter()
+        .map(|p| {
+            if !is_wall(p) {
+                return p.clone();
+            }
+            let start = corner::start_mid_line(&p.contour);
+            let corners = corner::inside_corners(&start);
+            let fits: Vec<(f64, Option<f64>)> = match s.corner_radius {
+                Some(r) => corners.iter().map(|_| (r, None)).collect(),
+                None => corner::fit_corners(&base, &start, &CORNER_RADII, limit, trochoid::PITCH_MARGIN_DEG, step)
+                    .into_iter()
+                    .map(|f| match f {
+                        Ok((r, e)) | Err((r, e)) => (r, Some(e)),
+                    })
+                    .collect(),
+            };
+            let at = |i: usize| corners.iter().position(|&c| c == i);
+            let (contour, rounded) = corner::round_with(&start, |i| at(i).map_or(0.0, |k| fits[k].0));
+            rests.extend(rounded.into_iter().zip(&fits).map(|(k, f)| corner::Rest {
+                corner: k.at - k.inward * (s.radius / (0.5 * k.turn).cos()),
+                inward: k.inward,
+                rho: k.rho,
+                turn: k.turn,
+                tool: s.radius,
+                fitted_deg: f.1,
+            }));
+            Pass { contour, ..p.clone() }
+        })
+        .collect();
+    (out, rests)
 }
 
 /// The medial axis as polylines: edges joined end to end through vertices where exactly two

@@ -60,6 +60,12 @@ struct Args {
     /// Material left on walls and islands (mm).
     #[arg(long, default_value_t = 0.0, value_name = "MM")]
     allowance: f64,
+    /// Radius of the tangent arcs that replace the wall passes' sharp inside corners (mm; 0 keeps
+    /// them sharp); default: each corner's smallest radius that holds the threshold in the
+    /// simulation. A round tool at a sharp inside corner has the whole corner in material (≥ 90°
+    /// at 90°): the rounded corners leave that rest to finishing (named in the report).
+    #[arg(long, value_name = "MM")]
+    corner_radius: Option<f64>,
     /// Engagement sample spacing along the path (mm); every move's end is also sampled.
     #[arg(long, default_value_t = 0.5, value_name = "MM")]
     sample: f64,
@@ -90,6 +96,14 @@ struct Args {
     /// Largest feed per tooth of the tool (mm).
     #[arg(long, default_value_t = 0.1, value_name = "MM")]
     fz_max: f64,
+    /// Hard-steel derating of the feed model: above this engagement (degrees; default the
+    /// threshold) the feed is multiplied by --derate.
+    #[arg(long, value_name = "DEG")]
+    derate_above: Option<f64>,
+    /// Factor on the feed above --derate-above (1: no derating). The report gives times and
+    /// ratios with and without it.
+    #[arg(long, default_value_t = 1.0, value_name = "K")]
+    derate: f64,
     /// Decimals of written positions (exact by default).
     #[arg(long, value_name = "N")]
     decimals: Option<u32>,
@@ -148,6 +162,12 @@ fn run(args: Args) -> Result<()> {
         trochoid_radius: rt,
         pitch: args.pitch,
         allowance: args.allowance,
+        corner_radius: match args.corner_radius {
+            Some(r) if !(r.is_finite() && r >= 0.0) => {
+                return Err(Error::input(format!("--corner-radius must be zero or more, got {r}")));
+            }
+            r => r,
+        },
         sample: positive(args.sample, "--sample")?,
         medial: MedialOptions {
             resolution: positive(args.resolution, "--resolution")?,
@@ -159,6 +179,11 @@ fn run(args: Args) -> Result<()> {
             teeth: positive(args.teeth, "--teeth")?,
             chip: positive(args.chip, "--chip")?,
             fz_max: positive(args.fz_max, "--fz-max")?,
+            derate_above: positive(args.derate_above.unwrap_or(threshold), "--derate-above")?,
+            derate: match positive(args.derate, "--derate")? {
+                k if k > 1.0 => return Err(Error::input(format!("--derate must be at most 1, got {k}"))),
+                k => k,
+            },
         },
     };
     let input = Input::open(&args.io.input)?;
@@ -240,6 +265,7 @@ fn run(args: Args) -> Result<()> {
             .set("threshold_held", b.max_cutting <= threshold + medial_trochoid::ENGAGEMENT_ROUNDOFF_DEG)
             .set("offset_only_samples_over_threshold", a.over)
             .set("samples_over_threshold", b.over)
+            .set("link_samples_over_threshold", b.over_links)
             .set("samples", b.samples.len())
             .set("smallest_wall_clearance_mm", b.wall_clearance)
             .set("no_gouge", b.wall_clearance >= r + args.allowance - camkit::tol::OFFSET_TOL)
@@ -248,6 +274,24 @@ fn run(args: Args) -> Result<()> {
             .set("trochoidal_minutes", b.minutes * layers)
             .set("trochoidal_constant_feed_minutes", b.minutes_constant * layers)
             .set("time_ratio", b.minutes / a.minutes_constant)
+            .set("derate_above_deg", settings.feed.derate_above)
+            .set("derate", settings.feed.derate)
+            .set("offset_only_underated_minutes", a.minutes_constant_underated * layers)
+            .set("trochoidal_underated_minutes", b.minutes_underated * layers)
+            .set("time_ratio_underated", b.minutes_underated / a.minutes_constant_underated)
+            .set("corner_rests", plan.rests.len())
+            .set("corner_radii_mm", plan.rests.iter().map(|c| c.rho).collect::<Vec<_>>())
+            .set("corner_rest_thickness_mm", plan.rests.iter().map(|c| c.thickness()).collect::<Vec<_>>())
+            .set("corner_rest_area_mm2", plan.rests.iter().map(|c| c.area()).collect::<Vec<_>>())
+            .set("corner_rest_at_mm", plan.rests.iter().map(|c| vec![c.corner.x, c.corner.y]).collect::<Vec<_>>())
+            .set("corner_rest_largest_thickness_mm", plan.rests.iter().map(|c| c.thickness()).fold(0.0, f64::max))
+            .set(
+                "corners_unfitted",
+                plan.rests
+                    .iter()
+                    .filter(|c| c.fitted_deg.is_some_and(|e| e > threshold + medial_trochoid::ENGAGEMENT_ROUNDOFF_DEG))
+                    .count(),
+            )
             .set("offset_only_length_mm", a.program.moves.iter().map(|m| m.seg.length()).sum::<f64>() * layers)
             .set("trochoid_length_mm", (b.program.length(Tag::Trochoid) + b.program.length(Tag::Entry)) * layers)
             .set("contour_length_mm", b.program.length(Tag::Contour) * layers)

@@ -71,6 +71,10 @@ pub fn plan_plot(title: &str, plan: &Plan, trochoidal: bool) -> Plot {
         for d in &plan.uncleared {
             p.polyline(d, Style::stroke("#ff7f0e", 3.0));
         }
+        for r in &plan.rests {
+            p.polygon(&r.outline(24), Style::fill("#2ca02c", 0.7));
+        }
+        p.legend("corner rest left to finishing (rounded wall pass)", Style::fill("#2ca02c", 0.7));
     }
     p.legend("contour", Style::stroke("black", 1.6))
         .legend("medial axis", Style::stroke("#7f7f7f", 1.0).dashed("4 2"))
