@@ -153,7 +153,7 @@ fn bad_input_is_refused() {
         })
         .collect();
     w.write("bulge.csv", format!("x,y,z\n{bulge}"));
-    let o = w.run(BIN, &["fit", "bulge.csv", "-o", "out.json", "--report", "r.json"], b"");
+    let o = w.run(BIN, &["fit", "bulge.csv", "-o", "out.json", "--report", "r.json", "--residuals", "res.csv"], b"");
     assert_eq!(o.status, 1, "{}", o.stderr);
     assert!(o.stderr.contains("radius ran off"), "{}", o.stderr);
     assert_eq!(o.stderr.trim_end().lines().count(), 1, "{}", o.stderr);
@@ -173,7 +173,7 @@ fn bad_input_is_refused() {
     w.run(BIN, &["fit", "nan.csv", "--robust", "ransac", "-o", "out.json"], b"").fails(2, "nan.csv:3");
     w.run(BIN, &["fit", "dup.csv", "--robust", "huber", "-o", "out.json"], b"").fails(2, "duplicate point");
     // Every refusal above wrote to out.json (and the failed fit its report): none exists.
-    assert!(!w.exists("out.json") && !w.exists("r.json"), "no partial output");
+    assert!(!w.exists("out.json") && !w.exists("r.json") && !w.exists("res.csv"), "no partial output");
 }
 
 #[test]
@@ -251,7 +251,7 @@ fn ransac_drops_gross_outliers_reproducibly() {
     w.write("dirty.csv", text);
     let fit = ["fit", "dirty.csv", "--robust", "ransac", "--seed", "3"];
     w.run(BIN, &[&fit[..], &["-o", "a.json", "--report", "r.json"]].concat(), b"").ok();
-    w.run(BIN, &[&fit[..], &["-o", "b.json"]].concat(), b"").ok();
+    w.run(BIN, &[&fit[..], &["-o", "b.json", "--residuals", "res.csv"]].concat(), b"").ok();
     assert_eq!(w.read("a.json"), w.read("b.json"), "the same seed gives the same frame");
     let r = json(&w, "r.json");
     assert_eq!(r["outliers"], 100, "{r}");
@@ -259,6 +259,15 @@ fn ransac_drops_gross_outliers_reproducibly() {
     assert_eq!(r["robust"]["method"], "ransac");
     let t = r["threshold_mm"].as_f64().unwrap();
     assert!(t > 0.002 && t < 0.5, "{r}");
+    // Per-point residuals: the input rows, the distance from the fit, the outliers flagged.
+    let res = w.read("res.csv");
+    let mut lines = res.lines();
+    assert_eq!(lines.next(), Some("x,y,z,residual,outlier"));
+    for (k, line) in lines.enumerate() {
+        let v: Vec<f64> = line.split(',').map(|x| x.parse().unwrap()).collect();
+        assert_eq!(v[4], if k < 200 { 0.0 } else { 1.0 }, "row {k}: {line}");
+        assert!(if k < 200 { v[3].abs() <= t } else { v[3] >= 0.5 }, "row {k}: {line}");
+    }
     // The outliers are the last 100 rows: lines 202.. (header line 1).
     assert_eq!(r["outlier_lines"].as_array().unwrap().len(), 20);
     assert_eq!(r["outlier_lines"][0], 202, "{r}");

@@ -137,6 +137,10 @@ struct FitArgs {
     /// The true element (a shape or frame document): its errors go into the report.
     #[arg(long, value_name = "FILE")]
     truth: Option<String>,
+    /// Write the input rows with each point's `residual` (signed orthogonal distance from the
+    /// fitted element, mm) and, with --robust ransac, `outlier` (1 for points left out) to FILE.
+    #[arg(long, value_name = "FILE")]
+    residuals: Option<PathBuf>,
 }
 
 #[derive(clap::Args, Debug)]
@@ -539,11 +543,42 @@ fn run_fit(args: FitArgs) -> Result<()> {
         truth_keys(&mut report, &f.shape, truth);
     }
     report.set("fit_seconds", fit_seconds).set("seconds", started.elapsed().as_secs_f64());
+    let residuals = args.residuals.as_deref().map(|path| -> Result<Output> {
+        let mut r = Output::new(Some(path));
+        table::write(&mut r, &residual_table(t, &pts, &f), &WriteOptions::default())?;
+        Ok(r)
+    });
+    let residuals = residuals.transpose()?;
     if let Some(path) = &args.io.report {
         report.write(path)?;
     }
+    if let Some(r) = residuals {
+        r.commit()?;
+    }
     out.commit()
 }
+
+/// The input rows with the `residual` of each point from the fitted element and, for RANSAC, the
+/// `outlier` flag.
+fn residual_table(mut t: Table, pts: &[P3], f: &surf_probe_fit::Fit) -> Table {
+    let r = t.add_extra_column("residual");
+    let outliers = f.robust.as_ref().filter(|i| i.method == "ransac").map(|i| &i.outlier_indices);
+    let o = outliers.map(|_| t.add_extra_column("outlier"));
+    let mut flagged = vec![false; pts.len()];
+    for &k in outliers.into_iter().flatten() {
+        flagged[k] = true;
+    }
+    for ((row, p), out) in t.rows.iter_mut().zip(pts).zip(flagged) {
+        row.extra[r] = format!("{:.*}", RESIDUAL_DECIMALS, f.shape.distance(p));
+        if let Some(o) = o {
+            row.extra[o] = if out { "1" } else { "0" }.into();
+        }
+    }
+    t
+}
+
+/// Decimals of the `residual` column (0.1 nm).
+const RESIDUAL_DECIMALS: usize = 7;
 
 /// Outlier lines named in the report (the first ones).
 const OUTLIER_LINES: usize = 20;

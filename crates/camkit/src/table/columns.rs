@@ -120,6 +120,8 @@ pub const COLUMNS: &[ColumnSpec] = &[
         "surf-probe-fit: laser sensor reading, distance along the beam (−tool axis)"
     ),
     named!("incidence", "degrees", "empty", "surf-probe-fit simulate: angle between the beam and the surface normal"),
+    named!("residual", "mm", "empty", "surf-probe-fit fit --residuals: signed distance from the fitted element"),
+    named!("outlier", "0/1", "empty", "surf-probe-fit fit --residuals, RANSAC: 1 for a point left out of the fit"),
     named!("tilt", "deg", "empty", "tool-attitude: tilt used (θ cylinder, ζ ball, flat-type axis correction)"),
     named!("r_edge", "mm", "empty", "tool-attitude: R' of paper 000 eq. 1 (cylindrical tool; empty: infinite)"),
     named!("flank_gap", "deg", "empty", "tool-attitude: stand-off of the flat-type tool's second flank"),
