@@ -5,6 +5,14 @@ Usage: bench-fit-scipy.py POINTS.csv OURS_FRAME.json [OURS_REPORT.json]
 Prints one JSON line: the largest difference (mm) of centre and radius between SciPy's
 Levenberg-Marquardt sphere fit (analytic Jacobian, tolerances at the floating-point floor,
 started from the same algebraic fit) and ours, SciPy's fit time and ours (fit only).
+
+Usage: bench-fit-scipy.py --outliers POINTS.csv N CX,CY,CZ,R SEED > DIRTY.csv
+Appends N gross outliers to a sphere's points: half pushed 0.5-5 mm out along the radius, half
+anywhere in the box of 1.5 R about the centre at least 0.5 mm off the sphere.
+
+Usage: bench-fit-scipy.py --robust DIRTY.csv OURS_FRAME.json OURS_REPORT.json CX,CY,CZ,R
+Prints one JSON line per SciPy robust loss (least_squares method "trf", f_scale 0.01 mm): its
+error against the true sphere and its time, beside ours (--robust ransac).
 """
 import json
 import sys
@@ -14,7 +22,7 @@ import numpy as np
 from scipy.optimize import least_squares
 
 
-def fit_sphere(p):
+def fit_sphere(p, loss=None):
     m = p.mean(axis=0)
     y = p - m
     a = np.column_stack([2 * y, np.ones(len(y))])
@@ -30,11 +38,51 @@ def fit_sphere(p):
         n = np.linalg.norm(d, axis=1)[:, None]
         return np.column_stack([-d / n, -np.ones(len(p))])
 
-    r = least_squares(res, x0, jac=jac, method="lm", xtol=1e-15, ftol=1e-15, gtol=1e-15)
+    if loss is None:
+        r = least_squares(res, x0, jac=jac, method="lm", xtol=1e-15, ftol=1e-15, gtol=1e-15)
+    else:
+        r = least_squares(res, x0, jac=jac, method="trf", loss=loss, f_scale=0.01, xtol=1e-15, ftol=1e-15,
+                          gtol=1e-15, max_nfev=1000)
     return r.x
 
 
+def add_outliers(path, n, truth, seed):
+    c, r = np.array(truth[:3]), truth[3]
+    rng = np.random.default_rng(seed)
+    sys.stdout.write(open(path).read())
+    for k in range(n):
+        if k % 2 == 0:
+            u = rng.normal(size=3)
+            p = c + u / np.linalg.norm(u) * (r + rng.uniform(0.5, 5.0))
+        else:
+            while True:
+                p = c + rng.uniform(-1.5 * r, 1.5 * r, size=3)
+                if abs(np.linalg.norm(p - c) - r) >= 0.5:
+                    break
+        print(",".join(repr(float(v)) for v in p))
+
+
+def robust(path, frame, report, truth):
+    pts = np.loadtxt(path, delimiter=",", skiprows=1, comments="#")
+    c, r = np.array(truth[:3]), truth[3]
+    err = lambda x: float(max(np.linalg.norm(np.array(x[:3]) - c), abs(x[3] - r)))
+    ours = json.load(open(frame))["fit"]
+    rep = json.load(open(report))
+    print(json.dumps({"method": "ours ransac", "points": len(pts), "error_mm": err(ours["centre"] + [ours["radius"]]),
+                      "seconds": rep["fit_seconds"], "outliers": rep["outliers"]}))
+    for loss in ["linear", "soft_l1", "huber", "cauchy", "arctan"]:
+        t = time.perf_counter()
+        x = fit_sphere(pts, loss)
+        s = time.perf_counter() - t
+        print(json.dumps({"method": f"scipy trf {loss}", "error_mm": err(x), "seconds": s}))
+
+
 def main():
+    if sys.argv[1] == "--outliers":
+        truth = [float(v) for v in sys.argv[4].split(",")]
+        return add_outliers(sys.argv[2], int(sys.argv[3]), truth, int(sys.argv[5]))
+    if sys.argv[1] == "--robust":
+        return robust(sys.argv[2], sys.argv[3], sys.argv[4], [float(v) for v in sys.argv[5].split(",")])
     pts = np.loadtxt(sys.argv[1], delimiter=",", skiprows=1, comments="#")
     ours = json.load(open(sys.argv[2]))["fit"]
     t = time.perf_counter()
