@@ -34,6 +34,13 @@ fn square_pocket_engagement_meets_closed_forms_and_trochoids_lower_it() {
     // The innermost pass of the offset-only program is a slot: exactly 180°.
     assert!((f("offset_only_largest_engagement_deg") - 180.0).abs() < 1e-6);
     assert!(f("largest_engagement_deg") < f("offset_only_largest_engagement_deg"));
+    // Trochoids first and the wall pass's corners rounded by simulation: the whole program's
+    // passes and loops hold the threshold (to the named round-off), every corner fitted.
+    assert!(f("largest_engagement_deg") <= 40.0 + 1e-5, "{r}");
+    assert_eq!(r["samples_over_threshold"], 0);
+    assert_eq!(r["threshold_held"], true);
+    assert_eq!(r["corners_unfitted"], 0);
+    assert_eq!(r["corner_rests"], 4);
     assert_eq!(r["no_gouge"], true);
     assert!((f("smallest_wall_clearance_mm") - 5.0).abs() < 1e-6);
     assert!(f("medial_equidistance_error_mm") < 1e-6);

@@ -117,18 +117,22 @@ pub struct Plan {
 /// line meets the previous pass's band tangentially).
 pub const ENGAGEMENT_ROUNDOFF_DEG: f64 = 1e-5;
 
-/// How many loop radii a plan tries: the given one and its halvings.
-const LEVELS: usize = 5;
+/// How many loop radii a plan tries: the given one and its shrinkings by [`LEVEL_RATIO`].
+const LEVELS: usize = 13;
 
-/// A stretch of the medial axis cleared by trochoids of one radius.
+/// Ratio of consecutive loop radii: fine enough that a loop's radius stays within a fifth of the
+/// largest that fits the clearance (halvings left up to half the clearance to the passes).
+const LEVEL_RATIO: f64 = 0.8;
+
+/// A stretch of the medial axis cleared by trochoids, the loops shrinking along it.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Run {
     /// The stretch (polyline, mm).
     pub points: Vec<P2>,
-    /// Loop radius (mm).
-    pub radius: f64,
-    /// Pitch (mm).
-    pub pitch: f64,
+    /// Loop radius at each point (mm), not increasing.
+    pub radii: Vec<f64>,
+    /// Pitch at each point (mm).
+    pub pitches: Vec<f64>,
 }
 
 /// Why a plan could not be made.
@@ -274,9 +278,9 @@ pub fn plan(regions: &[Region], s: &Settings) -> Result<Plan, PlanError> {
         .collect();
     let reach = s.step.max(s.sample);
     let grid = PointGrid::new(&hot, reach);
-    // Loop radii: the given one and halvings of it, so that runs reach into corners; each run
-    // keeps one radius, the largest that fits inside the clearance along it.
-    let radii: Vec<f64> = (0..LEVELS).map(|k| s.trochoid_radius / f64::from(1u32 << k)).collect();
+    // Loop radii: the given one and shrinkings of it, so that runs reach into corners; each
+    // loop has the largest that fits inside the clearance where it is.
+    let radii: Vec<f64> = (0..LEVELS).map(|k| s.trochoid_radius * LEVEL_RATIO.powi(k as i32)).collect();
     let pitches: Vec<Option<f64>> = radii
         .par_iter()
         .map(|&rt| match s.pitch {
@@ -294,29 +298,37 @@ pub fn plan(regions: &[Region], s: &Settings) -> Result<Plan, PlanError> {
     for (ri, m) in medial.iter().enumerate() {
         for chain in chains(&m.edges) {
             let pts = densify(&chain, spacing);
-            let flags: Vec<(bool, Option<usize>)> = pts
+            let flags: Vec<(bool, Option<(f64, f64)>)> = pts
                 .iter()
                 .map(|p| {
                     let hot = grid.any_within(p, reach);
                     // A loop's centre keeps its radius plus a pitch (the chord between centres
-                    // cuts bends of the axis) from the walls.
+                    // cuts bends of the axis) from the walls. The radius is the largest that
+                    // fits, at the pitch of the largest level that fits (a loop larger than its
+                    // level at that level's pitch engages less).
                     let cap = point_clearance(p, &regions[ri]) - wall;
                     let fits = |k: usize| pitches[k].is_some_and(|pk| radii[k] + pk <= cap);
-                    (hot, (0..LEVELS).find(|&k| fits(k)))
+                    let fit = (0..LEVELS).find(|&k| fits(k)).map(|k| {
+                        let pk = pitches[k].expect("a level that fits has a pitch");
+                        let above = if k == 0 { radii[0] } else { radii[k - 1] };
+                        ((cap - pk).min(above), pk)
+                    });
+                    (hot, fit)
                 })
                 .collect();
             danger.extend(stretches(&pts, &flags, |f| f.0));
             uncleared.extend(stretches(&pts, &flags, |f| f.0 && f.1.is_none()));
-            for k in 0..LEVELS {
-                for points in stretches(&pts, &flags, |f| f.0 && f.1 == Some(k)) {
-                    runs.push(Run { points, radius: radii[k], pitch: pitches[k].expect("levels with a pitch") });
+            let loops: Vec<(f64, f64)> = flags.iter().map(|f| f.1.unwrap_or((0.0, 0.0))).collect();
+            for (a, b) in spans(&flags, |f| f.0 && f.1.is_some()) {
+                for (points, radii, pitches) in shrinking(&pts[a..b], &loops[a..b]) {
+                    runs.push(Run { points, radii, pitches });
                 }
             }
         }
     }
     let mut troch = Program::default();
     for run in &runs {
-        trochoid::push_trochoids(&mut troch, &run.points, run.radius, run.pitch);
+        trochoid::push_varying(&mut troch, &run.points, &run.radii, &run.pitches);
     }
     let (passes, rests) = round_walls(&pocket.passes, &troch, s);
     let mut first = true;
@@ -460,6 +472,57 @@ fn densify(pts: &[P2], h: f64) -> Vec<P2> {
     out
 }
 
+/// Index ranges of the maximal runs of consecutive flags that pass `keep`.
+fn spans<F: Copy>(flags: &[F], keep: impl Fn(F) -> bool) -> Vec<(usize, usize)> {
+    let mut out = Vec::new();
+    let mut start = None;
+    for (i, &f) in flags.iter().enumerate() {
+        match (keep(f), start) {
+            (true, None) => start = Some(i),
+            (false, Some(a)) => {
+                out.push((a, i));
+                start = None;
+            }
+            _ => {}
+        }
+    }
+    if let Some(a) = start {
+        out.push((a, flags.len()));
+    }
+    out
+}
+
+/// A stretch with a loop (radius, pitch) per point cut into pieces along which the radius only
+/// shrinks: split where the trend turns (the turning point in both pieces), each piece directed
+/// from its larger loops to its smaller.
+fn shrinking(pts: &[P2], loops: &[(f64, f64)]) -> Vec<(Vec<P2>, Vec<f64>, Vec<f64>)> {
+    let mut out = Vec::new();
+    let mut start = 0;
+    let mut trend = 0.0;
+    let mut push = |a: usize, b: usize, trend: f64| {
+        let mut p = pts[a..b].to_vec();
+        let mut l = loops[a..b].to_vec();
+        if trend > 0.0 {
+            p.reverse();
+            l.reverse();
+        }
+        out.push((p, l.iter().map(|x| x.0).collect(), l.iter().map(|x| x.1).collect()));
+    };
+    for i in 1..loops.len() {
+        let d = loops[i].0 - loops[i - 1].0;
+        let d = if d.abs() <= camkit::tol::OFFSET_TOL { 0.0 } else { d.signum() };
+        if d != 0.0 && trend != 0.0 && d != trend {
+            push(start, i, trend);
+            start = i - 1;
+        }
+        if d != 0.0 {
+            trend = d;
+        }
+    }
+    push(start, loops.len(), trend);
+    out
+}
+
 /// Maximal runs of consecutive points whose flags pass `keep` (runs of one point included).
 fn stretches<F: Copy>(pts: &[P2], flags: &[F], keep: impl Fn(F) -> bool) -> Vec<Vec<P2>> {
     let mut out = Vec::new();
@@ -497,5 +560,29 @@ impl PointGrid {
         (kx - 1..=kx + 1).any(|x| {
             (ky - 1..=ky + 1).any(|y| self.map.get(&(x, y)).is_some_and(|v| v.iter().any(|q| (q - p).norm() <= r)))
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn runs_are_cut_where_the_loops_stop_shrinking() {
+        let pts: Vec<P2> = (0..7).map(|k| P2::new(f64::from(k), 0.0)).collect();
+        let r = [1.0, 2.0, 3.0, 3.0, 2.0, 1.0, 2.0];
+        let loops: Vec<(f64, f64)> = r.iter().map(|&x| (x, 0.1 * x)).collect();
+        let pieces = shrinking(&pts, &loops);
+        assert_eq!(pieces.len(), 3);
+        for (p, radii, pitches) in &pieces {
+            assert_eq!(p.len(), radii.len());
+            assert!(radii.windows(2).all(|w| w[1] <= w[0]), "{radii:?}");
+            assert!(pitches.iter().zip(radii).all(|(p, r)| (p - 0.1 * r).abs() < 1e-12));
+        }
+        // Every point is in some piece; turning points are shared.
+        assert_eq!(pieces[0].0[0], P2::new(3.0, 0.0));
+        assert_eq!(pieces[1].0[0], P2::new(3.0, 0.0));
+        assert_eq!(pieces[2].0, vec![P2::new(6.0, 0.0), P2::new(5.0, 0.0)]);
+        assert_eq!(spans(&[true, true, false, true], |f| f), vec![(0, 2), (3, 4)]);
     }
 }

@@ -255,8 +255,8 @@ fn run(args: Args) -> Result<()> {
             .set("trochoid_runs", plan.runs.len())
             .set("uncleared_stretches", plan.uncleared.len())
             .set("trochoid_radius_mm", rt)
-            .set("trochoid_radii_mm", runs_by(&plan, |r| r.radius))
-            .set("trochoid_pitches_mm", runs_by(&plan, |r| r.pitch))
+            .set("trochoid_radii_mm", runs_by(&plan, |r| &r.radii))
+            .set("trochoid_pitches_mm", runs_by(&plan, |r| &r.pitches))
             .set("offset_only_largest_engagement_deg", a.max_cutting)
             .set("offset_only_link_engagement_deg", a.max_link)
             .set("largest_engagement_deg", b.max_cutting)
@@ -316,15 +316,11 @@ fn s_feed(a: &Analysed, tag: Tag) -> f64 {
         .unwrap_or(0.0)
 }
 
-/// The distinct values of `f` over the plan's trochoid runs, in first-seen order.
-fn runs_by(plan: &medial_trochoid::Plan, f: impl Fn(&medial_trochoid::Run) -> f64) -> Vec<f64> {
-    let mut out: Vec<f64> = Vec::new();
-    for r in &plan.runs {
-        let v = f(r);
-        if !out.contains(&v) {
-            out.push(v);
-        }
-    }
+/// The distinct values of `f` over the plan's trochoid runs, largest first.
+fn runs_by(plan: &medial_trochoid::Plan, f: impl Fn(&medial_trochoid::Run) -> &Vec<f64>) -> Vec<f64> {
+    let mut out: Vec<f64> = plan.runs.iter().flat_map(|r| f(r).iter().copied()).collect();
+    out.sort_by(|a, b| b.total_cmp(a));
+    out.dedup();
     out
 }
 

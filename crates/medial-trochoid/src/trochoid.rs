@@ -9,20 +9,53 @@ use camkit::geom::{P2, V2};
 
 /// Appends trochoids along `run` with loop radius `rt` and `pitch` to `prog`.
 pub fn push_trochoids(prog: &mut Program, run: &[P2], rt: f64, pitch: f64) {
-    let centres = resample(run, pitch);
-    if centres.is_empty() {
-        return;
+    let centres: Vec<(P2, f64)> = resample(run, pitch).into_iter().map(|c| (c, rt)).collect();
+    push_loops(prog, &centres);
+}
+
+/// Appends trochoids along `run` whose loop radius and pitch at point `i` of the run are
+/// `radii[i]` and `pitches[i]`, radii not increasing along the run (a smaller loop after a
+/// larger one meets no more material than the pitch allows). Each step is the pitch at the
+/// far end of the step (the smaller), each loop the radius there.
+pub fn push_varying(prog: &mut Program, run: &[P2], radii: &[f64], pitches: &[f64]) {
+    let Some(&first) = run.first() else { return };
+    let mut cum = vec![0.0];
+    for w in run.windows(2) {
+        cum.push(cum[cum.len() - 1] + (w[1] - w[0]).norm());
     }
+    let total = cum[cum.len() - 1];
+    // Index of the first run point at or after arc length `s`.
+    let at = |s: f64| cum.partition_point(|&c| c < s).min(run.len() - 1);
+    let point = |s: f64| {
+        let j = at(s).max(1);
+        let (a, b) = (run[j - 1], run[j]);
+        let len = cum[j] - cum[j - 1];
+        if len <= 0.0 { b } else { a + (b - a) * ((s - cum[j - 1]) / len).clamp(0.0, 1.0) }
+    };
+    let mut centres = vec![(first, radii[0])];
+    let mut s = 0.0;
+    while s < total {
+        let p = pitches[at(s)].min(pitches[at(s + pitches[at(s)])]);
+        s = (s + p).min(total);
+        centres.push((point(s), radii[at(s)]));
+    }
+    push_loops(prog, &centres);
+}
+
+/// Appends one loop per centre (with its radius): a helical entry circle at the first, then one
+/// counter-clockwise (climb) circle per centre, each started on the right of travel.
+fn push_loops(prog: &mut Program, centres: &[(P2, f64)]) {
+    let pts: Vec<P2> = centres.iter().map(|c| c.0).collect();
     let mut previous: Option<P2> = None;
-    for (k, c) in centres.iter().enumerate() {
-        let d = direction(&centres, k);
+    for (k, &(c, rt)) in centres.iter().enumerate() {
+        let d = direction(&pts, k);
         let right = V2::new(d.y, -d.x);
         let s = c + right * rt;
         if let Some(p) = previous {
             prog.moves.push(Move { seg: Seg::Line(p, s), tag: Tag::Trochoid, retract_before: false });
         }
         let start = (s - c).y.atan2((s - c).x);
-        let circle = Contour::circle(*c, rt, start, true);
+        let circle = Contour::circle(c, rt, start, true);
         let tag = if k == 0 { Tag::Entry } else { Tag::Trochoid };
         prog.push_contour(&circle, tag, k == 0);
         previous = Some(s);
@@ -111,6 +144,30 @@ mod tests {
             assert!((w[1] - w[0]).norm() <= 1.0 + 1e-12);
         }
         assert_eq!(c[c.len() - 1], P2::new(3.0, 4.0));
+    }
+
+    #[test]
+    fn varying_loops_shrink_along_the_run_at_their_pitch() {
+        let run: Vec<P2> = (0..=20).map(|k| P2::new(f64::from(k) * 0.5, 0.0)).collect();
+        let radii: Vec<f64> = (0..=20).map(|k| 2.0 - 0.05 * f64::from(k)).collect();
+        let pitches: Vec<f64> = radii.iter().map(|r| 0.1 * r).collect();
+        let mut prog = Program::default();
+        push_varying(&mut prog, &run, &radii, &pitches);
+        // Loop centres (arc centres), in order: steps never longer than the pitch at their far end.
+        let mut centres: Vec<(P2, f64)> = Vec::new();
+        for m in &prog.moves {
+            if let Seg::Arc(a) = m.seg
+                && centres.last().is_none_or(|c| (c.0 - a.c).norm() > 1e-12)
+            {
+                centres.push((a.c, a.r));
+            }
+        }
+        assert!(centres.len() > 20);
+        for w in centres.windows(2) {
+            assert!(w[1].1 <= w[0].1 + 1e-12);
+            assert!((w[1].0 - w[0].0).norm() <= 0.1 * w[1].1 + 0.1 * 0.05 * 0.5 + 1e-12);
+        }
+        assert!((centres[centres.len() - 1].0 - P2::new(10.0, 0.0)).norm() < 1e-12);
     }
 
     #[test]
