@@ -510,3 +510,76 @@ fn bad_input_is_refused_with_one_line_and_no_output_file() {
         assert!((d - 1.0).abs() <= TOL, "{p} at {d}");
     }
 }
+
+#[test]
+fn loops_touching_at_exactly_2r_are_cut_as_two_loops_meeting_at_the_point() {
+    let w = Work::new();
+    // Two rooms joined by a passage whose walls bulge in as half circles of radius 4 about
+    // (25, 5) and (25, 15): exactly 2 mm wide at (25, 10), so at R = 1 the loops touch there.
+    let rows = [
+        "0,rapid,0,0,,",
+        "0,line,20,0,,",
+        "0,line,20,5,,",
+        "0,line,21,5,,",
+        "0,cw,29,5,25,5",
+        "0,line,30,5,,",
+        "0,line,30,0,,",
+        "0,line,50,0,,",
+        "0,line,50,20,,",
+        "0,line,30,20,,",
+        "0,line,30,15,,",
+        "0,line,29,15,,",
+        "0,cw,21,15,25,15",
+        "0,line,20,15,,",
+        "0,line,20,20,,",
+        "0,line,0,20,,",
+        "0,line,0,0,,",
+    ];
+    w.write("bumps.csv", format!("{HEAD}{}\n", rows.join("\n")));
+    let shape = paths(&w.read("bumps.csv")).remove(0);
+    let out = w.run(BIN, &["bumps.csv", "--radius", "1", "--side", "left", "--report", "r.json"], b"").ok();
+    let ps = paths(&out);
+    assert_eq!(ps.len(), 2, "one loop per room, split where they touch");
+    let touch = P2::new(25.0, 10.0);
+    for path in &ps {
+        let pts = samples(path);
+        assert!(pts.iter().any(|p| (p - touch).norm() <= TOL), "each loop reaches the touching point");
+        for p in pts {
+            let d = shape.iter().map(|s| s.distance(&p)).fold(f64::INFINITY, f64::min);
+            assert!((d - 1.0).abs() <= TOL, "{p} at {d}");
+        }
+    }
+    assert!(report(&w, "r.json")["largest_deviation_mm"].as_f64().unwrap() <= TOL);
+}
+
+#[test]
+fn a_closed_self_crossing_contour_is_offset_on_request_to_what_can_be_cut() {
+    let w = Work::new();
+    // A bow tie crossing itself at (10, 5): refused by default, offset on request into the left
+    // lobe's triangle shrunk by 1 mm and an open stretch around the right lobe.
+    let bow = pts(&[(0.0, 0.0), (20.0, 10.0), (20.0, 0.0), (0.0, 10.0)]);
+    w.write("bow.csv", format!("{HEAD}{}", polygon_csv(0, &bow)));
+    w.run(BIN, &["bow.csv", "--radius", "1", "--side", "left"], b"")
+        .fails(2, "crosses itself at (10.000000, 5.000000)");
+    let out = w.run(BIN, &["bow.csv", "--radius", "1", "--side", "left", "--allow-self-crossing"], b"").ok();
+    let ps = paths(&out);
+    assert_eq!(ps.len(), 2, "{out}");
+    let r5 = 5f64.sqrt();
+    let corners = [P2::new(10.0 - r5, 5.0), P2::new(1.0, 0.5 + 0.5 * r5), P2::new(1.0, 9.5 - 0.5 * r5)];
+    let ends = |p: &[Piece]| (p[0].at(0.0), p[p.len() - 1].at(1.0));
+    let (tri, open): (Vec<&Vec<Piece>>, Vec<&Vec<Piece>>) = ps.iter().partition(|p| {
+        let (a, b) = ends(p);
+        (a - b).norm() < TOL
+    });
+    assert_eq!((tri.len(), open.len()), (1, 1));
+    for q in corners {
+        assert!(tri[0].iter().any(|s| (s.at(0.0) - q).norm() < 1e-6), "corner {q}");
+    }
+    let (a, b) = ends(open[0]);
+    for q in [P2::new(10.0, 5.0 + 0.5 * r5), P2::new(10.0, 5.0 - 0.5 * r5)] {
+        assert!((a - q).norm() < 1e-6 || (b - q).norm() < 1e-6, "open end {q}");
+    }
+    for p in ps.iter().flat_map(|p| samples(p)) {
+        assert!((polygon_distance(&p, &bow) - 1.0).abs() <= TOL, "{p}");
+    }
+}

@@ -100,7 +100,9 @@ struct Args {
     /// 3D mode: largest distance beyond R of a point around a convex corner (mm).
     #[arg(long, default_value_t = 0.001, value_name = "MM")]
     chord_tol: f64,
-    /// Accept self-crossing contours (contour mode): the kernel resolves the crossings.
+    /// Accept self-crossing contours (contour mode): the kernel resolves the crossings; a closed
+    /// one gives what the tool can cut on that side (loops, and open stretches that end where
+    /// they would gouge).
     #[arg(long)]
     allow_self_crossing: bool,
     /// Input format.

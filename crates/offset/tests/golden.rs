@@ -76,8 +76,10 @@ fn touching_and_splitting_loops_at_a_neck() {
         true,
     );
     assert_eq!(offset(&rooms, 0.999, Side::Left).len(), 1);
-    // At exactly half the neck the two loops touch along the neck's middle line: the check
-    // refuses touching loops, so this is a clear error naming a point there, not a result.
+    // At exactly half the neck the two loops coincide along the neck's middle line, a stretch
+    // and not one point (loops touching at one point are split there and accepted: see
+    // camkit's `loops_touching_at_exactly_2r_are_split_at_the_touching_point`): still a clear
+    // error naming a point there, not a result.
     let e = offset_contour(&rooms, 1.0, Side::Left, &OffsetOptions::default()).expect_err("touching loops");
     let Defect::Crossing(p) = e.defect else { panic!("{e}") };
     assert!((p.y - 10.0).abs() < 1e-9 && (20.0..=30.0).contains(&p.x), "{p}");

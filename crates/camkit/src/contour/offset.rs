@@ -163,7 +163,10 @@ fn verified_from(
         };
         for &eps in &scale {
             attempts += 1;
-            let out = kernel(loops, eps);
+            let mut out = kernel(loops, eps);
+            // A loop no longer than the tolerance is round-off where two loops touch (the lens
+            // between two tangent circles): the tool would cut nothing there.
+            out.retain(|c| c.length() > opts.tol);
             match verify(&set, &out, d, side, closed, opts.tol, opts.self_crossing_input) {
                 Ok(check) => return Ok(Offset { contours: out, check, attempts, cleaned: was_cleaned }),
                 Err(e) => defect = Some(e),
@@ -174,10 +177,14 @@ fn verified_from(
 }
 
 /// Offsets one contour by `d` (mm, > 0) to `side`, verified. The offset of an open contour is
-/// open pieces; of a closed one, closed loops.
+/// open pieces; of a closed one, closed loops (which may touch at a vertex), unless it crosses
+/// itself and `opts.self_crossing_input` allows that: then loops and open stretches.
 pub fn offset_contour(c: &Contour, d: f64, side: Side, opts: &OffsetOptions) -> Result<Offset, OffsetError> {
     let signed = d * side.sign();
-    verified(&[c], d, side.sign(), c.closed, opts, |source, (pos, dist)| {
+    // A closed contour that crosses itself has no side that stays inside: its offset is what the
+    // tool can cut on that side, loops and open stretches ending where they would gouge.
+    let closed = c.closed && !(opts.self_crossing_input && c.self_crossing().is_some());
+    verified(&[c], d, side.sign(), closed, opts, |source, (pos, dist)| {
         let pline: Polyline<f64> = source[0].to_pline();
         let o = PlineOffsetOptions {
             handle_self_intersects: opts.self_crossing_input,
@@ -276,6 +283,89 @@ mod tests {
         assert!(matches!(far, Err(Defect::Stray(..))), "{far:?}");
         let near = check_offset(&[&rooms], &o.contours, 1.5 + 1e-5, Side::Left, true, 1e-6);
         assert!(matches!(near, Err(Defect::Gouge(..))), "{near:?}");
+    }
+
+    /// Two 20 × 20 rooms joined by a passage 10 mm wide whose walls bulge in as half circles of
+    /// radius 4 about (25, 5) and (25, 15): at R = 1 the passage is exactly 2R wide at (25, 10).
+    fn rooms_with_bumps() -> Contour {
+        let v = |x: f64, y: f64, bulge: f64| crate::contour::Vertex { p: P2::new(x, y), bulge };
+        #[rustfmt::skip]
+        let vertices = vec![
+            v(0.0, 0.0, 0.0), v(20.0, 0.0, 0.0), v(20.0, 5.0, 0.0), v(21.0, 5.0, -1.0), v(29.0, 5.0, 0.0),
+            v(30.0, 5.0, 0.0), v(30.0, 0.0, 0.0), v(50.0, 0.0, 0.0), v(50.0, 20.0, 0.0), v(30.0, 20.0, 0.0),
+            v(30.0, 15.0, 0.0), v(29.0, 15.0, -1.0), v(21.0, 15.0, 0.0), v(20.0, 15.0, 0.0), v(20.0, 20.0, 0.0),
+            v(0.0, 20.0, 0.0),
+        ];
+        Contour { vertices, closed: true }
+    }
+
+    #[test]
+    fn loops_touching_at_exactly_2r_are_split_at_the_touching_point() {
+        use crate::contour::Seg;
+        use crate::geom::Arc2;
+        let c = rooms_with_bumps();
+        let o = offset_contour(&c, 1.0, Side::Left, &OffsetOptions::default()).unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(o.contours.len(), 2, "one loop per room");
+        let touch = P2::new(25.0, 10.0);
+        for l in &o.contours {
+            assert!(l.vertices.iter().any(|v| (v.p - touch).norm() < 1e-6), "each loop reaches (25, 10)");
+        }
+        // Closed form of the left loop: the room shrunk by 1, round about the passage's corners,
+        // then the offsets (radius 5) of both bumps up to the touching point.
+        let h = 25.0 - 24f64.sqrt();
+        let (p, line) = (P2::new, |a: (f64, f64), b: (f64, f64)| Seg::Line(P2::new(a.0, a.1), P2::new(b.0, b.1)));
+        let cw = |c: P2, a: P2, b: P2| Seg::Arc(Arc2::from_centre(c, &a, &b, false, false));
+        let left = Contour::from_segs(
+            &[
+                line((1.0, 1.0), (19.0, 1.0)),
+                line((19.0, 1.0), (19.0, 5.0)),
+                cw(p(20.0, 5.0), p(19.0, 5.0), p(20.0, 6.0)),
+                line((20.0, 6.0), (h, 6.0)),
+                cw(p(25.0, 5.0), p(h, 6.0), touch),
+                cw(p(25.0, 15.0), touch, p(h, 14.0)),
+                line((h, 14.0), (20.0, 14.0)),
+                cw(p(20.0, 15.0), p(20.0, 14.0), p(19.0, 15.0)),
+                line((19.0, 15.0), (19.0, 19.0)),
+                line((19.0, 19.0), (1.0, 19.0)),
+                line((1.0, 19.0), (1.0, 1.0)),
+            ],
+            true,
+        );
+        let areas: Vec<f64> = o.contours.iter().map(Contour::area).collect();
+        for a in &areas {
+            assert!((a - left.area()).abs() < 1e-6, "{a} vs {} (the right room by symmetry)", left.area());
+        }
+        // Just under 2R the passage joins the rooms into one loop; just over, two loops apart.
+        assert_eq!(offset_contour(&c, 0.999, Side::Left, &OffsetOptions::default()).unwrap().contours.len(), 1);
+        let apart = offset_contour(&c, 1.001, Side::Left, &OffsetOptions::default()).unwrap();
+        assert_eq!(apart.contours.len(), 2);
+        assert!(apart.contours[0].crossing_with(&apart.contours[1]).is_none());
+    }
+
+    #[test]
+    fn a_closed_self_crossing_contour_offsets_to_what_can_be_cut() {
+        // A bow tie crossing itself at (10, 5): left of travel is inside the left lobe and
+        // outside the right one. Offset by 1: the left lobe's triangle shrunk by 1 (closed form)
+        // and an open stretch around the right lobe ending where it would gouge the left one.
+        let bow =
+            Contour::polygon(&[P2::new(0.0, 0.0), P2::new(20.0, 10.0), P2::new(20.0, 0.0), P2::new(0.0, 10.0)], true);
+        let opts = OffsetOptions { self_crossing_input: true, ..OffsetOptions::default() };
+        let o = offset_contour(&bow, 1.0, Side::Left, &opts).unwrap_or_else(|e| panic!("{e}"));
+        let r5 = 5f64.sqrt();
+        let (closed, open): (Vec<&Contour>, Vec<&Contour>) = o.contours.iter().partition(|c| c.closed);
+        assert_eq!((closed.len(), open.len()), (1, 1));
+        let corners = [P2::new(10.0 - r5, 5.0), P2::new(1.0, 0.5 + 0.5 * r5), P2::new(1.0, 9.5 - 0.5 * r5)];
+        assert_eq!(closed[0].vertices.len(), 3);
+        for q in corners {
+            assert!(closed[0].vertices.iter().any(|v| (v.p - q).norm() < 1e-9), "corner {q}");
+        }
+        let ends = [open[0].vertices[0].p, open[0].vertices.last().unwrap().p];
+        for q in [P2::new(10.0, 5.0 + 0.5 * r5), P2::new(10.0, 5.0 - 0.5 * r5)] {
+            assert!(ends.iter().any(|e| (e - q).norm() < 1e-9), "open end {q}: {ends:?}");
+        }
+        // Without the permission the crossing is refused by the caller; the kernel alone would
+        // find no closed result.
+        assert!(offset_contour(&bow, 1.0, Side::Left, &OffsetOptions::default()).is_err());
     }
 
     #[test]

@@ -5,7 +5,8 @@
 //! it), after splitting the piece if no single generator covers it; it lies on the requested side
 //! of its generator. Then the input is probed for stretches the output missed: the raw offset
 //! point of every input piece's middle that is a valid offset point must lie on the output.
-//! Finally the output loops must not cross themselves or each other.
+//! Finally the output loops must not cross themselves or each other; they may touch at a vertex
+//! of both (the loops of two parts of the input exactly 2R apart meet there and part again).
 //!
 //! Speed without weakening: every search goes through a spatial index of the pieces' boxes with
 //! a reused traversal stack, and only pieces whose bounding circles come within reach are
@@ -188,6 +189,13 @@ impl SegSet {
 
     /// First point where two pieces that do not follow each other meet: a crossing or a touch.
     pub fn first_crossing(&self) -> Option<P2> {
+        self.first_meeting(0.0)
+    }
+
+    /// First point where two pieces that do not follow each other meet, except where they touch
+    /// at a vertex of both (ends within `touch` mm) and nowhere else: loops that come together at
+    /// one point and part again, as the offsets of two parts of a contour exactly 2R apart do.
+    pub fn first_meeting(&self, touch: f64) -> Option<P2> {
         (0..self.segs.len())
             .into_par_iter()
             .map_init(Vec::new, |stack, i| {
@@ -201,6 +209,7 @@ impl SegSet {
                         && !self.adjacent(i, j)
                         && self.circle_within(j, &cs, rs, 0.0)
                         && s.min_distance(&self.segs[j]) == 0.0
+                        && !(touch > 0.0 && self.touch_at_vertex(i, j, touch))
                     {
                         first = Some(j);
                     }
@@ -210,6 +219,28 @@ impl SegSet {
             })
             .find_first(|p| p.is_some())
             .flatten()
+    }
+
+    /// True if pieces `i` and `j` have ends within `touch` of each other and, without the
+    /// stretch of `2·touch` at that end of either, do not meet.
+    fn touch_at_vertex(&self, i: usize, j: usize, touch: f64) -> bool {
+        let ((a0, a1), (b0, b1)) = (self.ends[i], self.ends[j]);
+        let (s, t) = (&self.segs[i], &self.segs[j]);
+        for (ea, at_end_a) in [(a0, false), (a1, true)] {
+            for (eb, at_end_b) in [(b0, false), (b1, true)] {
+                if (ea - eb).norm() <= touch {
+                    let apart = |p: &Seg, at_end: bool, q: &Seg| {
+                        let k = 2.0 * touch / p.length();
+                        k >= 1.0 || {
+                            let rest = if at_end { p.sub(0.0, 1.0 - k) } else { p.sub(k, 1.0) };
+                            rest.min_distance(q) > 0.0
+                        }
+                    };
+                    return apart(s, at_end_a, t) && apart(t, at_end_b, s);
+                }
+            }
+        }
+        false
     }
 
     /// True if some piece lies within `reach` of `p` (at most `reach` if `inclusive`, else
@@ -508,8 +539,8 @@ fn verify_with(
     if let Some(c) = missing {
         return Err(Defect::Missing(c));
     }
-    // No output loop crosses itself or another.
-    if !crossing_input && let Some(p) = out.first_crossing() {
+    // No output loop crosses itself or another (touching at a vertex of both is not crossing).
+    if !crossing_input && let Some(p) = out.first_meeting(tol) {
         return Err(Defect::Crossing(p));
     }
     Ok(check)
@@ -535,10 +566,10 @@ mod tests {
     }
 
     fn star_parts() -> impl Strategy<Value = (Vec<f64>, Vec<f64>)> {
-        (8usize..160).prop_flat_map(|n| {
+        (8usize..64).prop_flat_map(|n| {
             (
                 prop::collection::vec(20.0f64..40.0, n),
-                prop::collection::vec(prop_oneof![1 => Just(0.0), 1 => -0.3f64..0.3], n),
+                prop::collection::vec(prop_oneof![3 => Just(0.0), 1 => -0.25f64..0.25], n),
             )
         })
     }
@@ -554,6 +585,28 @@ mod tests {
                 .prop_map(|(a, b, c, d)| Seg::Line(P2::new(a, b), P2::new(c, d))),
             arc().prop_map(Seg::Arc),
         ]
+    }
+
+    #[test]
+    fn loops_touching_at_a_vertex_do_not_cross() {
+        let square = |x: f64, y: f64| {
+            Contour::polygon(
+                &[P2::new(x, y), P2::new(x + 2.0, y), P2::new(x + 2.0, y + 2.0), P2::new(x, y + 2.0)],
+                true,
+            )
+        };
+        // Corner to corner at (2, 2): a touch, reported only by the strict test.
+        let (a, b) = (square(0.0, 0.0), square(2.0, 2.0));
+        let set = SegSet::new([&a, &b]);
+        assert_eq!(set.first_crossing(), Some(P2::new(2.0, 2.0)));
+        assert_eq!(set.first_meeting(1e-6), None);
+        // Overlapping by 1 mm: their edges cross at (2, 1) and (1, 2), away from any corner.
+        let c = square(1.0, 1.0);
+        let x = SegSet::new([&a, &c]).first_meeting(1e-6).expect("a crossing");
+        assert!((x - P2::new(2.0, 1.0)).norm() < 1e-12 || (x - P2::new(1.0, 2.0)).norm() < 1e-12, "{x}");
+        // A corner on the other's edge: no shared vertex, a meeting.
+        let d = square(2.0, 1.0);
+        assert!(SegSet::new([&a, &d]).first_meeting(1e-6).is_some());
     }
 
     proptest! {
