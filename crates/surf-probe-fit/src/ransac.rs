@@ -125,17 +125,15 @@ struct Scored {
 }
 
 fn score(shape: Shape, points: &[P3], threshold: Option<f64>, s: usize) -> Scored {
-    let r: Vec<f64> = points.iter().map(|x| residual(&shape, x)).collect();
+    let mut r: Vec<f64> = points.iter().map(|x| residual(&shape, x)).collect();
     match threshold {
         Some(t) => {
             let cost = r.iter().map(|r| (r * r).min(t * t)).sum();
             Scored { cost, shape, inliers: r.iter().filter(|&&r| r <= t).count(), scale: 0.0 }
         }
         None => {
-            let mut sorted = r.clone();
-            let mid = sorted.len() / 2;
-            let (_, med, _) = sorted.select_nth_unstable_by(mid, f64::total_cmp);
-            let med = *med;
+            let mid = r.len() / 2;
+            let med = *r.select_nth_unstable_by(mid, f64::total_cmp).1;
             let scale = robust_scale(med, points.len(), s);
             let t = threshold_of(scale);
             Scored { cost: med, shape, inliers: r.iter().filter(|&&r| r <= t).count(), scale }
