@@ -5,7 +5,9 @@
 //! With a given inlier threshold the hypotheses are scored by MSAC's truncated cost
 //! `Σ min(rᵢ², t²)`; without one by the median of `rᵢ²` (least median of squares), and the
 //! threshold is `2.5 σ̂` with Rousseeuw's robust scale `σ̂ = 1.4826 (1 + 5/(n − s)) √med rᵢ²` of
-//! the best hypothesis. The number of hypotheses follows from the wanted confidence `p` and the
+//! the best hypothesis. Each new best is replaced by the least-squares fit of its inliers when
+//! that scores better (LO-RANSAC), so the scale comes from a refit, not from a noisy minimal
+//! sample. The number of hypotheses follows from the wanted confidence `p` and the
 //! best inlier ratio `w` seen so far: `N = ln(1 − p) / ln(1 − wˢ)` (without a given threshold
 //! `w` is taken as at most ½, the breakdown point of the median: a poor element's own threshold
 //! is wide and would count most points as its inliers). Samples come from one seeded
