@@ -27,7 +27,8 @@ impl FeedModel {
     pub fn feed(&self, deg: f64) -> f64 {
         let s = deg.clamp(0.0, 90.0).to_radians().sin();
         let fz = if s <= 0.0 { self.fz_max } else { (self.chip / s).min(self.fz_max) };
-        let k = if deg > self.derate_above { self.derate } else { 1.0 };
+        // A side cut at exactly the threshold is not derated for its round-off.
+        let k = if deg > self.derate_above + crate::ENGAGEMENT_ROUNDOFF_DEG { self.derate } else { 1.0 };
         fz * self.teeth * self.spindle * k
     }
 

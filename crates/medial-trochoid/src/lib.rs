@@ -120,6 +120,9 @@ pub const ENGAGEMENT_ROUNDOFF_DEG: f64 = 1e-5;
 /// How many loop radii a plan tries: the given one and its shrinkings by [`LEVEL_RATIO`].
 const LEVELS: usize = 13;
 
+/// The smallest loop a plan tries, as a fraction of the given loop radius.
+pub const SMALLEST_LOOP: f64 = 0.068_719_476_736; // LEVEL_RATIO^(LEVELS − 1) = 0.8^12
+
 /// Ratio of consecutive loop radii: fine enough that a loop's radius stays within a fifth of the
 /// largest that fits the clearance (halvings left up to half the clearance to the passes).
 const LEVEL_RATIO: f64 = 0.8;
@@ -584,5 +587,6 @@ mod tests {
         assert_eq!(pieces[1].0[0], P2::new(3.0, 0.0));
         assert_eq!(pieces[2].0, vec![P2::new(6.0, 0.0), P2::new(5.0, 0.0)]);
         assert_eq!(spans(&[true, true, false, true], |f| f), vec![(0, 2), (3, 4)]);
+        assert!((SMALLEST_LOOP - LEVEL_RATIO.powi(LEVELS as i32 - 1)).abs() < 1e-15);
     }
 }

@@ -206,8 +206,9 @@ fn run(args: Args) -> Result<()> {
     let out_table = to_table(chosen, z0, args.layers, args.layer_depth);
     if !plan.uncleared.is_empty() {
         cli::warn(&format!(
-            "{} dangerous stretches of the medial axis are too narrow for a trochoid of radius {rt} mm: left to the passes",
-            plan.uncleared.len()
+            "{} dangerous stretches of the medial axis are too narrow for the smallest trochoid loop ({:.3} mm, the given {rt} mm shrunk): left to the passes",
+            plan.uncleared.len(),
+            rt * medial_trochoid::SMALLEST_LOOP
         ));
     }
     let mut out = Output::new(args.io.output.as_deref());
@@ -255,8 +256,8 @@ fn run(args: Args) -> Result<()> {
             .set("trochoid_runs", plan.runs.len())
             .set("uncleared_stretches", plan.uncleared.len())
             .set("trochoid_radius_mm", rt)
-            .set("trochoid_radii_mm", runs_by(&plan, |r| &r.radii))
-            .set("trochoid_pitches_mm", runs_by(&plan, |r| &r.pitches))
+            .set("trochoid_radius_range_mm", range(plan.runs.iter().flat_map(|r| r.radii.iter().copied())))
+            .set("trochoid_pitch_range_mm", range(plan.runs.iter().flat_map(|r| r.pitches.iter().copied())))
             .set("offset_only_largest_engagement_deg", a.max_cutting)
             .set("offset_only_link_engagement_deg", a.max_link)
             .set("largest_engagement_deg", b.max_cutting)
@@ -316,12 +317,10 @@ fn s_feed(a: &Analysed, tag: Tag) -> f64 {
         .unwrap_or(0.0)
 }
 
-/// The distinct values of `f` over the plan's trochoid runs, largest first.
-fn runs_by(plan: &medial_trochoid::Plan, f: impl Fn(&medial_trochoid::Run) -> &Vec<f64>) -> Vec<f64> {
-    let mut out: Vec<f64> = plan.runs.iter().flat_map(|r| f(r).iter().copied()).collect();
-    out.sort_by(|a, b| b.total_cmp(a));
-    out.dedup();
-    out
+/// Smallest and largest of `v` (empty if none).
+fn range(v: impl Iterator<Item = f64>) -> Vec<f64> {
+    let (lo, hi) = v.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), x| (lo.min(x), hi.max(x)));
+    if lo <= hi { vec![lo, hi] } else { Vec::new() }
 }
 
 /// For each move, where it starts along its helical entry loop and how much of the loop it
