@@ -104,6 +104,8 @@ impl Tangent {
 pub struct Job<'a> {
     /// The run's points.
     pub pts: &'a [P3],
+    /// The same points as written (rounded once per run: the search asks for the same ends often).
+    pub written: &'a [P3],
     /// First point of the piece.
     pub first: usize,
     /// Last point of the piece.
@@ -120,13 +122,18 @@ impl Job<'_> {
     fn span(&self) -> &[P3] {
         &self.pts[self.first..=self.last]
     }
+
+    /// The piece's end as written.
+    fn end(&self) -> P3 {
+        self.written[self.last]
+    }
 }
 
 /// Tries a line.
-pub fn line(job: &Job, opts: &Options, rounding: &dyn Rounding) -> Option<Piece> {
+pub fn line(job: &Job, opts: &Options) -> Option<Piece> {
     let pts = job.span();
     let a = job.start;
-    let b = rounding.point(&pts[pts.len() - 1]);
+    let b = job.end();
     if let Some(t) = &job.tangent {
         let dir = camkit::geom::dist::unit2(&(t.plane.split(&b).0 - t.plane.split(&a).0))?;
         if !t.allows(&dir) {
@@ -160,7 +167,7 @@ pub fn arc(job: &Job, plane: Plane, opts: &Options, rounding: &dyn Rounding) -> 
     }
     let pts = job.span();
     let (s, _) = plane.split(&job.start);
-    let (e, _) = plane.split(&rounding.point(&pts[pts.len() - 1]));
+    let (e, _) = plane.split(&job.end());
     let bisector = Bisector::new(&s, &e)?;
     let inner = || pts[1..pts.len() - 1].iter().map(|p| plane.split(p).0);
     let reach = opts.tol * (1.0 + MINIMAX_REACH);
@@ -263,7 +270,7 @@ fn arc_about(
     let none = (None, f64::INFINITY);
     let pts = job.span();
     let a = job.start;
-    let b = rounding.point(&pts[pts.len() - 1]);
+    let b = job.end();
     let (pa, _) = plane.split(&a);
     let r = (pa - c).norm();
     if r < opts.min_radius || r > opts.max_radius || !r.is_finite() {
@@ -313,11 +320,11 @@ const PROBE_POINTS: usize = 16;
 /// A quick guess whether a piece would fit: a line, or the least-squares arc of a subsample of
 /// the points, within the tolerance at those points. Not a proof (chords, winding and the points
 /// between are not looked at): the search uses it to find where to measure exactly.
-pub fn probe(job: &Job, opts: &Options, rounding: &dyn Rounding) -> bool {
+pub fn probe(job: &Job, opts: &Options) -> bool {
     let pts = job.span();
     let n = pts.len() - 1;
     let a = job.start;
-    let b = rounding.point(&pts[n]);
+    let b = job.end();
     let step = (n / PROBE_POINTS).max(1);
     let sample = || (step..n).step_by(step).map(|k| &pts[k]);
     if sample().all(|p| camkit::geom::dist::point_segment(p, &a, &b) <= opts.tol) {
@@ -343,7 +350,7 @@ pub fn probe(job: &Job, opts: &Options, rounding: &dyn Rounding) -> bool {
 /// The best piece for a job: a line when one fits (fewer numbers, no radius to round),
 /// otherwise an arc in the first plane that fits.
 pub fn best(job: &Job, opts: &Options, rounding: &dyn Rounding) -> Option<Piece> {
-    if let Some(p) = line(job, opts, rounding) {
+    if let Some(p) = line(job, opts) {
         return Some(p);
     }
     opts.planes.iter().find_map(|&plane| arc(job, plane, opts, rounding))

@@ -93,6 +93,8 @@ pub fn fit_program(
         blocks.iter().map(|b| if let Block::Move(m) = b { Some(m) } else { None }).collect();
     let mut stats = Stats { input_moves: moves.iter().flatten().count(), ..Stats::default() };
     let mut runs = Vec::new();
+    // Block index of each run point (one buffer for all runs).
+    let mut from: Vec<usize> = Vec::new();
     let mut written = 0;
     let mut k = 0;
     while k < blocks.len() {
@@ -117,7 +119,7 @@ pub fn fit_program(
         }
         // At most one point per block of the run, plus its start: reserve once, not per push.
         let mut pts = Vec::with_capacity(end + 2 - k);
-        let mut from = Vec::with_capacity(end + 2 - k);
+        from.clear();
         pts.push(head.start);
         from.push(k);
         for (i, m) in moves.iter().enumerate().take(end + 1).skip(k) {

@@ -20,10 +20,19 @@ pub fn segment(pts: &[P3], opts: &Options, rounding: &dyn Rounding) -> Result<Ve
         return Ok(Vec::new());
     }
     let corners = corners(pts, opts.corner, opts.tol);
+    let written: Vec<P3> = pts.iter().map(|p| rounding.point(p)).collect();
+    let run = Run { pts, written: &written, corners: &corners };
     match opts.method {
-        Method::Fewest => fewest(pts, &corners, opts, rounding),
-        Method::Paper => paper(pts, &corners, opts, rounding),
+        Method::Fewest => fewest(&run, opts, rounding),
+        Method::Paper => paper(&run, opts, rounding),
     }
+}
+
+/// A run's points, as given and as written, and where it turns a corner.
+struct Run<'a> {
+    pts: &'a [P3],
+    written: &'a [P3],
+    corners: &'a [bool],
 }
 
 /// `true` at the interior points where the path turns by more than `limit` radians between
@@ -55,15 +64,16 @@ fn tangent_after(prev: Option<&Piece>, corners: &[bool], opts: &Options) -> Opti
 }
 
 /// Where the piece after `prev` starts, as written.
-fn start_after(prev: Option<&Piece>, pts: &[P3], rounding: &dyn Rounding) -> P3 {
-    prev.map_or_else(|| rounding.point(&pts[0]), |p| p.end)
+fn start_after(prev: Option<&Piece>, run: &Run) -> P3 {
+    prev.map_or(run.written[0], |p| p.end)
 }
 
 /// The shortest single move from `first`: one chord to the next point, as a line.
-fn single(pts: &[P3], first: usize, start: P3, opts: &Options, rounding: &dyn Rounding) -> Result<Piece, Unfittable> {
+fn single(run: &Run, first: usize, start: P3, opts: &Options) -> Result<Piece, Unfittable> {
     let relaxed = Options { tol: f64::INFINITY, ..opts.clone() };
-    let job = Job { pts, first, last: first + 1, start, tangent: None, thorough: false };
-    let piece = fit::line(&job, &relaxed, rounding).ok_or(Unfittable { at: first, deviation: f64::INFINITY })?;
+    let (pts, written) = (run.pts, run.written);
+    let job = Job { pts, written, first, last: first + 1, start, tangent: None, thorough: false };
+    let piece = fit::line(&job, &relaxed).ok_or(Unfittable { at: first, deviation: f64::INFINITY })?;
     if piece.deviation > opts.tol {
         return Err(Unfittable { at: first, deviation: piece.deviation });
     }
@@ -76,8 +86,9 @@ fn single(pts: &[P3], first: usize, start: P3, opts: &Options, rounding: &dyn Ro
 /// runs below it. Then a short look past the end, measured exactly with minimax centres too
 /// (validity is not always monotone in the end index). When validity is monotone (any piece
 /// inside a valid one is valid), greedy longest-first is optimal for the number of pieces.
-fn fewest(pts: &[P3], corners: &[bool], opts: &Options, rounding: &dyn Rounding) -> Result<Vec<Piece>, Unfittable> {
+fn fewest(run: &Run, opts: &Options, rounding: &dyn Rounding) -> Result<Vec<Piece>, Unfittable> {
     const LOOK_PAST: usize = 3;
+    let (pts, written, corners) = (run.pts, run.written, run.corners);
     let n = pts.len();
     // A piece never spans a corner: the first corner (or the end) after each point.
     let mut next_stop = vec![n - 1; n];
@@ -89,10 +100,10 @@ fn fewest(pts: &[P3], corners: &[bool], opts: &Options, rounding: &dyn Rounding)
     while first < n - 1 {
         let limit = next_stop[first];
         let tangent = tangent_after(pieces.last(), corners, opts);
-        let start = start_after(pieces.last(), pts, rounding);
-        let job = |last: usize, thorough: bool| Job { pts, first, last, start, tangent, thorough };
+        let start = start_after(pieces.last(), run);
+        let job = |last: usize, thorough: bool| Job { pts, written, first, last, start, tangent, thorough };
         let exact = |last: usize, thorough: bool| fit::best(&job(last, thorough), opts, rounding);
-        let probe = |last: usize| fit::probe(&job(last, false), opts, rounding);
+        let probe = |last: usize| fit::probe(&job(last, false), opts);
         let guess = pieces.last().map(|p| first + (p.last - p.first));
         let reach = farthest(first + 1, limit, guess, probe);
         // Measure the probe's answer; if it does not hold, search below it exactly.
@@ -102,7 +113,7 @@ fn fewest(pts: &[P3], corners: &[bool], opts: &Options, rounding: &dyn Rounding)
                 let floor = match exact(first + 1, false) {
                     Some(p) => p,
                     // Tangent continuity cannot hold here (a turn below the corner angle): start afresh.
-                    None => single(pts, first, start, opts, rounding)?,
+                    None => single(run, first, start, opts)?,
                 };
                 let (mut lo, mut hi, mut good) = (first + 1, reach, floor);
                 while hi - lo > 1 {
@@ -167,7 +178,8 @@ fn farthest(lo: usize, limit: usize, guess: Option<usize>, fits: impl Fn(usize) 
 /// Paper 004 §2: the curvature of each point from the circle through it and its neighbours;
 /// consecutive points at or over the threshold are grouped and approximated by arcs, those under
 /// it by lines; a group is split where a point strays beyond the tolerance.
-fn paper(pts: &[P3], corners: &[bool], opts: &Options, rounding: &dyn Rounding) -> Result<Vec<Piece>, Unfittable> {
+fn paper(run: &Run, opts: &Options, rounding: &dyn Rounding) -> Result<Vec<Piece>, Unfittable> {
+    let (pts, written, corners) = (run.pts, run.written, run.corners);
     let n = pts.len();
     let plane = opts.planes[0];
     let flat: Vec<_> = pts.iter().map(|p| plane.split(p).0).collect();
@@ -188,15 +200,15 @@ fn paper(pts: &[P3], corners: &[bool], opts: &Options, rounding: &dyn Rounding) 
             end += 1;
         }
         let tangent = tangent_after(pieces.last(), corners, opts);
-        let start = start_after(pieces.last(), pts, rounding);
+        let start = start_after(pieces.last(), run);
         // The paper's pieces run through the points: every end is a point.
         let try_fit = |last: usize| {
-            let job = Job { pts, first, last, start, tangent, thorough: true };
-            if curved[first] { fit::arc(&job, plane, opts, rounding) } else { fit::line(&job, opts, rounding) }
+            let job = Job { pts, written, first, last, start, tangent, thorough: true };
+            if curved[first] { fit::arc(&job, plane, opts, rounding) } else { fit::line(&job, opts) }
         };
         let mut good = match try_fit(first + 1) {
             Some(p) => p,
-            None => single(pts, first, start, opts, rounding)?,
+            None => single(run, first, start, opts)?,
         };
         for last in first + 2..=end {
             match try_fit(last) {

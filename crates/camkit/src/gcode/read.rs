@@ -242,9 +242,11 @@ impl Reader<'_> {
     fn apply_modal(&mut self, words: &[Word], line: &[u8], line_no: u32) -> Result<GEffects> {
         let mut fx = GEffects::default();
         for w in words {
-            let code = (w.value * 10.0).round() as i64;
+            // G and M codes to one decimal (G90.1 is 901); other letters carry no code.
+            let code = || (w.value * 10.0).round() as i64;
             match w.letter {
                 b'G' => {
+                    let code = code();
                     match code {
                         0 | 10 | 20 | 30 => {
                             if fx.motion.is_some() {
@@ -303,7 +305,7 @@ impl Reader<'_> {
                     }
                     fx.extra_g = true;
                 }
-                b'M' => match code {
+                b'M' => match code() {
                     820 => self.e_mode_relative = false,
                     830 => self.e_mode_relative = true,
                     _ => {}
