@@ -3,7 +3,8 @@
 # vertices, lines and arcs, r = 50 + 15 cos 8θ) offset by 2 and 5 mm inward and 2 mm outward,
 # and a pocket of the 10 k line star to empty (R 1.5, step 2).
 #   1. bare cavalier_contours (default options) against our verified offset
-#      (`crates/offset/examples/offset_peers.rs`: median times, bare results run through our check);
+#      (`crates/offset/examples/offset_peers.rs`: runs interleaved bare/ours, median and best
+#      times, bare results run through our check);
 #   2. pyclipper (PyPI, Clipper 1, integer polygons: arcs become chords) on the same vertices.
 #
 #   scripts/bench-offset.sh
@@ -11,8 +12,11 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 WORK=${WORK:-target/bench-offset}
 mkdir -p "$WORK"
+cargo build -q --release -p offset --example offset_peers
+echo "== load before: $(uptime)"
 echo "== cavalier_contours (bare) vs offset's verified kernel"
 cargo run -q --release -p offset --example offset_peers -- "$WORK"
+echo "== load after: $(uptime)"
 
 if [ ! -x "$WORK/venv/bin/python" ]; then
   python3 -m venv "$WORK/venv"

@@ -1,5 +1,6 @@
 //! Side by side with bare cavalier_contours on dense stars and a pocket to empty: time (median
-//! of repeated runs), whether bare cavalier's result passes our verification, and our retries.
+//! and best of interleaved runs), whether bare cavalier's result passes our verification, and
+//! our retries.
 //! Also writes the inputs as polygons for the pyclipper script (`scripts/bench-offset.sh`).
 //!
 //! `cargo run --release -p offset --example offset_peers -- [OUTDIR]`
@@ -41,25 +42,33 @@ fn contour_of(p: &Polyline<f64>) -> Contour {
     }
 }
 
-/// Median seconds of `runs` calls.
-fn time<T>(runs: usize, mut f: impl FnMut() -> T) -> (f64, T) {
-    let mut out = None;
-    let mut t: Vec<f64> = (0..runs)
-        .map(|_| {
-            let s = Instant::now();
-            out = Some(f());
-            s.elapsed().as_secs_f64()
-        })
-        .collect();
-    t.sort_by(f64::total_cmp);
-    (t[runs / 2], out.expect("ran"))
+/// Median and best seconds of `runs` calls of `a` and of `b`, interleaved (a, b, a, b, ...) so
+/// that both see the same load, with the last results.
+fn time2<A, B>(runs: usize, mut a: impl FnMut() -> A, mut b: impl FnMut() -> B) -> ([f64; 2], [f64; 2], A, B) {
+    let (mut ta, mut tb, mut ra, mut rb) = (Vec::new(), Vec::new(), None, None);
+    for _ in 0..runs {
+        let s = Instant::now();
+        ra = Some(a());
+        ta.push(s.elapsed().as_secs_f64());
+        let s = Instant::now();
+        rb = Some(b());
+        tb.push(s.elapsed().as_secs_f64());
+    }
+    let stats = |t: &mut Vec<f64>| {
+        t.sort_by(f64::total_cmp);
+        [t[t.len() / 2], t[0]]
+    };
+    (stats(&mut ta), stats(&mut tb), ra.expect("ran"), rb.expect("ran"))
 }
 
 fn main() {
     let dir = std::env::args().nth(1).unwrap_or_else(|| "target/offset-bench".into());
     std::fs::create_dir_all(&dir).expect("output dir");
-    println!("| input | offset | bare cavalier ms | bare result | ours ms | kernel runs | ratio |");
-    println!("|---|---|---|---|---|---|---|");
+    println!(
+        "| input | offset | bare cavalier ms (median / best) | bare result | ours ms (median / best) | kernel runs | \
+         ratio median | ratio best |"
+    );
+    println!("|---|---|---|---|---|---|---|---|");
     for (n, arcs) in [(1000, false), (10_000, false), (1000, true), (10_000, true)] {
         let c = star(n, arcs);
         let poly: String = c.vertices.iter().map(|v| format!("{},{}\n", v.p.x, v.p.y)).collect();
@@ -67,14 +76,17 @@ fn main() {
         std::fs::write(format!("{dir}/{name}.csv"), format!("x,y\n{poly}")).expect("write");
         let p = pline(&c);
         for d in [2.0, 5.0, -2.0] {
-            let runs = if n > 5000 { 7 } else { 21 };
-            let (bare_s, bare) = time(runs, || p.parallel_offset_opt(d, &PlineOffsetOptions::default()));
-            let open = bare.iter().filter(|q| !q.is_closed()).count();
+            let runs = if n > 5000 { 9 } else { 31 };
             let side = if d > 0.0 { Side::Left } else { Side::Right };
+            let (bare_s, ours_s, bare, ours) = time2(
+                runs,
+                || p.parallel_offset_opt(d, &PlineOffsetOptions::default()),
+                || offset_contour(&c, d.abs(), side, &OffsetOptions::default()),
+            );
+            let open = bare.iter().filter(|q| !q.is_closed()).count();
             // Bare cavalier's own result through our verification.
             let bare_contours: Vec<Contour> = bare.iter().map(contour_of).collect();
             let bare_check = check_offset(&[&c], &bare_contours, d.abs(), side, true, OffsetOptions::default().tol);
-            let (ours_s, ours) = time(runs, || offset_contour(&c, d.abs(), side, &OffsetOptions::default()));
             let (verdict, runs_used) = match &ours {
                 Ok(o) => (format!("{} loops", o.contours.len()), o.attempts.to_string()),
                 Err(e) => (format!("error: {e}"), "-".into()),
@@ -84,10 +96,13 @@ fn main() {
                 Err(e) => format!("FAILS ({} pieces, {open} open): {}", bare.len(), e.describe()),
             };
             println!(
-                "| {name} | {d:+} | {:.2} | {bare_text} | {:.2} ({verdict}) | {runs_used} | {:.2} |",
-                bare_s * 1e3,
-                ours_s * 1e3,
-                ours_s / bare_s
+                "| {name} | {d:+} | {:.2} / {:.2} | {bare_text} | {:.2} / {:.2} ({verdict}) | {runs_used} | {:.2} | {:.2} |",
+                bare_s[0] * 1e3,
+                bare_s[1] * 1e3,
+                ours_s[0] * 1e3,
+                ours_s[1] * 1e3,
+                ours_s[0] / bare_s[0],
+                ours_s[1] / bare_s[1]
             );
         }
     }
@@ -102,7 +117,7 @@ fn main() {
         offset: OffsetOptions::default(),
     };
     let shape = Shape::from_plines([pline(&rs[0].outer)]);
-    let (bare_s, levels) = time(5, || {
+    let bare = || {
         let mut k = 0;
         loop {
             let s = shape.parallel_offset(1.5 + 2.0 * k as f64, &ShapeOffsetOptions::default());
@@ -111,16 +126,19 @@ fn main() {
             }
             k += 1;
         }
-    });
-    let (ours_s, ours) = time(5, || pocket(&rs, &opts));
+    };
+    let (bare_s, ours_s, levels, ours) = time2(5, bare, || pocket(&rs, &opts));
     let ours = ours.expect("pocket");
     println!(
-        "| star-10000-lines pocket | r 1.5 step 2 | {:.2} | {levels} levels | {:.2} ({} passes, {} levels) | {} | {:.2} |",
-        bare_s * 1e3,
-        ours_s * 1e3,
+        "| star-10000-lines pocket | r 1.5 step 2 | {:.2} / {:.2} | {levels} levels | {:.2} / {:.2} ({} passes, {} levels) | {} | {:.2} | {:.2} |",
+        bare_s[0] * 1e3,
+        bare_s[1] * 1e3,
+        ours_s[0] * 1e3,
+        ours_s[1] * 1e3,
         ours.passes.len(),
         ours.passes.iter().map(|p| p.level + 1).max().unwrap_or(0),
         ours.attempts,
-        ours_s / bare_s
+        ours_s[0] / bare_s[0],
+        ours_s[1] / bare_s[1]
     );
 }

@@ -9,7 +9,8 @@
 //! of both (the loops of two parts of the input exactly 2R apart meet there and part again).
 //!
 //! Speed without weakening: every search goes through a spatial index of the pieces' boxes with
-//! a reused traversal stack (one search for a group of consecutive output pieces), and only
+//! a reused traversal stack (one search for a group of consecutive output pieces, or nearest
+//! first for each piece where the group's box holds too much of the input), and only
 //! pieces whose bounding circles come within reach are measured exactly, by closed forms that
 //! test an arc's span with cross products instead of angles. Output pieces are checked in fixed blocks along their loops, each piece
 //! trying its predecessor's generator and that generator's neighbours first (a consecutive
@@ -23,7 +24,9 @@ use super::{Contour, Seg};
 use crate::geom::dist::{point_segment, segment_segment_min};
 use crate::geom::{Arc2, P2, V2, cross2};
 use crate::tol;
-use cavalier_contours::static_aabb2d_index::{Control, StaticAABB2DIndex, StaticAABB2DIndexBuilder};
+use cavalier_contours::static_aabb2d_index::{
+    Control, NeighborPriorityQueue, StaticAABB2DIndex, StaticAABB2DIndexBuilder,
+};
 use rayon::prelude::*;
 use std::f64::consts::TAU;
 
@@ -111,7 +114,10 @@ pub(crate) struct SegSet {
 #[derive(Default)]
 struct Scratch {
     stack: Vec<usize>,
+    queue: NeighborPriorityQueue<f64>,
     near: Vec<usize>,
+    /// One piece's own candidates, when the group's are too many.
+    own: Vec<usize>,
     cands: Vec<(f64, usize)>,
 }
 
@@ -121,6 +127,9 @@ const BLOCK: usize = 64;
 /// Consecutive output pieces that share one search of the index (their boxes' union grown by
 /// d + tol); each then filters the list by its own circle.
 const GROUP: usize = 8;
+
+/// A group's candidates beyond which each piece searches nearest first on its own.
+const CROWD: usize = 512;
 
 impl SegSet {
     /// The pieces of `contours`.
@@ -174,6 +183,21 @@ impl SegSet {
         let c: Control<()> =
             ix.visit_query_with_stack(lo.x - grow, lo.y - grow, hi.x + grow, hi.y + grow, &mut visitor, stack);
         matches!(c, Control::Break(()))
+    }
+
+    /// Calls `f` with every piece whose box comes within `reach` of `p`, nearest first: a disc
+    /// rather than a box, which matters when `reach` is large against the pieces.
+    fn visit_nearest(&self, p: &P2, reach: f64, queue: &mut NeighborPriorityQueue<f64>, mut f: impl FnMut(usize)) {
+        let Some(ix) = &self.index else { return };
+        let limit = reach * reach;
+        let mut visitor = |i: usize, d2: f64| {
+            if d2 > limit {
+                return Control::Break(());
+            }
+            f(i);
+            Control::Continue
+        };
+        let _: Control<()> = ix.visit_neighbors_with_queue(p.x, p.y, &mut visitor, queue);
     }
 
     /// True if the circle around piece `i` comes within `reach` of the circle `(c, r)`.
@@ -681,6 +705,21 @@ fn verify_with(
                     });
                 }
                 let p = Piece::new(out.segs[i], out.circles[i]);
+                if scratch.near.len() > CROWD {
+                    // Far from the input (a deep pocket level): the box holds much of it, while
+                    // the disc of reach around this piece holds only the pieces nearest to it.
+                    let Scratch { queue, own, .. } = scratch;
+                    own.clear();
+                    input.visit_nearest(&p.c, d + tol + p.r, queue, |j| own.push(j));
+                    std::mem::swap(&mut scratch.near, &mut scratch.own);
+                    let r = check_piece(input, &p, spec, hint, 0, scratch);
+                    std::mem::swap(&mut scratch.near, &mut scratch.own);
+                    let (a, b, g) = r?;
+                    above = above.max(a);
+                    below = below.max(b);
+                    hint = Some(g);
+                    continue;
+                }
                 let (a, b, g) = check_piece(input, &p, spec, hint, 0, scratch)?;
                 above = above.max(a);
                 below = below.max(b);
@@ -769,6 +808,30 @@ mod tests {
                 .prop_map(|(a, b, c, d)| Seg::Line(P2::new(a, b), P2::new(c, d))),
             arc().prop_map(Seg::Arc),
         ]
+    }
+
+    #[test]
+    fn deep_offsets_search_nearest_first_and_still_find_every_defect() {
+        // A 1200-gon of circumradius 50 and its inward offset by 45 in closed form (the same
+        // polygon, circumradius 50 − 45 / cos(π/n)): every group's box holds much of the input
+        // (more than CROWD pieces), so each piece searches nearest first.
+        let n = 1200;
+        let gon = |r: f64| {
+            let pts: Vec<P2> =
+                (0..n).map(|k| TAU * k as f64 / n as f64).map(|a| P2::new(r * a.cos(), r * a.sin())).collect();
+            Contour::polygon(&pts, true)
+        };
+        let (c, d) = (gon(50.0), 45.0);
+        let out = [gon(50.0 - d / (std::f64::consts::PI / n as f64).cos())];
+        let input = SegSet::new([&c]);
+        let check = verify(&input, &out, d, 1.0, true, 1e-6, false).unwrap();
+        assert!(check.deviation() < 1e-9, "{check:?}");
+        for (d, want) in [(d - 1e-5, "stray"), (d + 1e-5, "gouge")] {
+            match (verify(&input, &out, d, 1.0, true, 1e-6, false), want) {
+                (Err(Defect::Stray(..)), "stray") | (Err(Defect::Gouge(..)), "gouge") => {}
+                (r, _) => panic!("{want}: {r:?}"),
+            }
+        }
     }
 
     #[test]
