@@ -1,10 +1,11 @@
 # globe (paper 002): a sphere on the A/C table measured on the machine by a simulated laser sensor —
 # a 3-axis raster, its rough Delaunay surface, a 5-axis plan along the surface normals (posted to NC),
 # the 5-axis measurement — and fitted: the workpiece frame for post-6axis, with the 3-axis and
-# 5-axis fit errors against the true sphere side by side (summary.txt). Then Japan's coastline
+# 5-axis fit errors against the true sphere side by side (summary.txt). Then Honshu's coastline
 # (Natural Earth) mapped by longitude and latitude onto the fitted sphere, tool axis along the
-# normal, offset for a flat end mill in the plane normal to the axis (offset --3d), and posted for
-# the A/C table machine in the measured workpiece frame (globe.ngc).
+# normal, offset for a φ0.2 mm flat end mill in the plane normal to the axis (offset --3d, which
+# refuses a path that would cut into a coastline: with R 1.5, or with Hokkaido and Kyushu beside
+# Honshu, it does), and posted for the A/C table machine in the measured workpiece frame (globe.ngc).
 DEMOS += globe
 FILTERS += surf-probe-fit offset post-6axis
 GLOBE := $(OUT)/globe
@@ -17,10 +18,10 @@ GLOBE_Z ?= 115.5
 GLOBE_EVERY ?= 5
 GLOBE_STANDOFF ?= 50
 GLOBE_SEED ?= 1
-GLOBE_COAST ?= data/surf-probe-fit/japan-coastline.json
+GLOBE_COAST ?= data/surf-probe-fit/honshu-coastline.json
 GLOBE_LON0 ?= 138
 GLOBE_DEPTH ?= 0.2
-GLOBE_TOOL_R ?= 1.5
+GLOBE_TOOL_R ?= 0.1
 GLOBE_FEED ?= 300
 
 .PHONY: demo-globe

@@ -389,10 +389,10 @@ fn closed_offset_passes_on_a_reference_frame_read_back() {
     w.run(fit, &["reference", "--centre", "3.2,-1.7,40.5", "--extent", "90", "--points", "300", "-o", "pts.csv"], b"")
         .ok();
     w.run(fit, &["fit", "pts.csv", "-o", "frame.json"], b"").ok();
-    let coast = data("surf-probe-fit/japan-coastline.json").to_str().unwrap().to_string();
+    let coast = data("surf-probe-fit/honshu-coastline.json").to_str().unwrap().to_string();
     w.run(fit, &["map", &coast, "--frame", "frame.json", "--lon0", "138", "--depth", "0.2", "-o", "coast.csv"], b"")
         .ok();
-    w.run("offset", &["coast.csv", "--3d", "--radius", "1.5", "--side", "left", "-o", "off.csv"], b"").ok();
+    w.run("offset", &["coast.csv", "--3d", "--radius", "0.1", "--side", "left", "-o", "off.csv"], b"").ok();
     let m = machine("paper002-ac.json");
     let args = ["off.csv", "-m", &m, "--frame", "frame.json", "--feed", "300", "-o", "globe.nc", "--report", "r.json"];
     w.run(BIN, &args, b"").ok();

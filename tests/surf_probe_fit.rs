@@ -182,7 +182,7 @@ fn coastline_on_the_fitted_sphere_is_offset_normal_to_the_tool_axis() {
     w.run(BIN, &["reference", "--centre", "3.2,-1.7,40.5", "--extent", "90", "--points", "300", "-o", "pts.csv"], b"")
         .ok();
     w.run(BIN, &["fit", "pts.csv", "-o", "frame.json"], b"").ok();
-    let coast = d("surf-probe-fit/japan-coastline.json");
+    let coast = d("surf-probe-fit/honshu-coastline.json");
     let args = ["map", &coast, "--frame", "frame.json", "--lon0", "138", "--depth", "0.2", "-o", "coast.csv"];
     w.run(BIN, &args, b"").ok();
     let radius = json(&w, "frame.json")["fit"]["radius"].as_f64().unwrap();
@@ -195,9 +195,19 @@ fn coastline_on_the_fitted_sphere_is_offset_normal_to_the_tool_axis() {
         assert!((v[0] / r - v[3]).abs() < 1e-9 && (v[2] / r - v[5]).abs() < 1e-9, "axis along the normal: {line}");
         rows += 1;
     }
-    assert!(rows > 100);
-    w.run("offset", &["coast.csv", "--3d", "--radius", "1.5", "--side", "left", "-o", "off.csv"], b"").ok();
+    assert!(rows > 80);
+    w.run("offset", &["coast.csv", "--3d", "--radius", "0.1", "--side", "left", "-o", "off.csv"], b"").ok();
     assert!(w.read("off.csv").lines().count() > 100);
+    // A φ3 mm tool does not fit Honshu's bays, and around all three islands a tool would cut into
+    // the neighbouring island (straits under 0.1 mm on this globe): refused, nothing written.
+    let out = w.run("offset", &["coast.csv", "--3d", "--radius", "1.5", "--side", "left", "-o", "big.csv"], b"");
+    out.fails(1, "the tool does not fit there");
+    let japan = d("surf-probe-fit/japan-coastline.json");
+    let args = ["map", &japan, "--frame", "frame.json", "--lon0", "138", "--depth", "0.2", "-o", "japan.csv"];
+    w.run(BIN, &args, b"").ok();
+    let out = w.run("offset", &["japan.csv", "--3d", "--radius", "0.1", "--side", "left", "-o", "japan-off.csv"], b"");
+    out.fails(1, "the tool does not fit there");
+    assert!(!w.exists("big.csv") && !w.exists("japan-off.csv"));
     // NC for the A/C table machine on the fitted frame; post-6axis reads its program back.
     let machine = d("post-6axis/paper002-ac.json");
     let post = ["off.csv", "-m", &machine, "--frame", "frame.json", "--feed", "300"];

@@ -395,6 +395,8 @@ pub fn space_mode(table: &Table, name: &str, opts: &space::Options) -> Result<Ou
     let k = out.add_extra_column(OFFSET_COLUMN);
     let (mut above, mut below, mut rounded, mut trimmed, mut merged, mut path) = (0.0f64, 0.0f64, 0, 0, 0, 0i64);
     let (mut drawn_in, mut drawn_out) = (Vec::new(), Vec::new());
+    // Every pass's input and output (closed ones repeat their first point), for the gouge check.
+    let (mut tracks_in, mut tracks_out, mut first_lines) = (Vec::new(), Vec::new(), Vec::new());
     for pass in table.passes() {
         let mut rows: Vec<&Row> = Vec::new();
         for r in pass {
@@ -461,6 +463,17 @@ pub fn space_mode(table: &Table, name: &str, opts: &space::Options) -> Result<Ou
             out.rows.push(row);
             first = false;
         }
+        let mut track_in = pts.clone();
+        if closed {
+            track_in.push(pts[0]);
+        }
+        let mut track_axes: Vec<V3> = o.points.iter().map(|p| axes[p.row]).collect();
+        if closed && let Some(p) = o.points.first() {
+            track_axes.push(axes[p.row]);
+        }
+        tracks_in.push(track_in);
+        tracks_out.push((ring.clone(), track_axes));
+        first_lines.push(rows[0].line);
         drawn_in.push(pts.iter().map(|p| P2::new(p.x, p.y)).collect::<Vec<_>>());
         drawn_out.push(ring.iter().map(|p| P2::new(p.x, p.y)).collect::<Vec<_>>());
         path += 1;
@@ -468,8 +481,22 @@ pub fn space_mode(table: &Table, name: &str, opts: &space::Options) -> Result<Ou
     if path == 0 {
         return Err(Error::input("no contour: the table has no pass with two distinct points").at(Location::file(name)));
     }
+    let outputs: Vec<space::Track> = tracks_out.iter().map(|(p, a)| space::Track { pts: p, axes: a }).collect();
+    let inputs: Vec<&[P3]> = tracks_in.iter().map(Vec::as_slice).collect();
+    let gouge = space::gouge(&outputs, &inputs, opts.radius);
+    if gouge.depth > opts.chord_tol {
+        let (o, k) = gouge.at;
+        return Err(Error::check(format!(
+            "the offset of the pass starting at line {} comes {:.4} mm nearer than R = {} mm to the contour of the \
+             pass starting at line {} (its move to point {k}): the tool does not fit there (each pass is offset \
+             on its own: passes closer than 2R, or bays narrower than 2R, need a smaller tool)",
+            first_lines[o], gouge.depth, opts.radius, first_lines[gouge.input]
+        ))
+        .at(Location::file(name).line(first_lines[o])));
+    }
     report
         .set("output_paths", path)
+        .set("largest_gouge_mm", gouge.depth)
         .set("largest_excess_mm", above)
         .set("largest_shortfall_mm", below)
         .set("rounded_corners", rounded)

@@ -81,6 +81,13 @@ impl Frame {
         Some(Frame { o, u, v: a.cross(&u) })
     }
 
+    /// A frame of the plane through `o` perpendicular to `axis` (a unit vector), any rotation.
+    fn across(o: P3, axis: &V3) -> Frame {
+        let helper = if axis.x.abs() < 0.9 { V3::x() } else { V3::y() };
+        let u = axis.cross(&helper).normalize();
+        Frame { o, u, v: axis.cross(&u) }
+    }
+
     fn flat(&self, p: &P3) -> P2 {
         let d = p - self.o;
         P2::new(d.dot(&self.u), d.dot(&self.v))
@@ -275,5 +282,94 @@ fn nearest_on(seg: &camkit::contour::Seg, p: &P2) -> P2 {
                 if (s - p).norm() <= (e - p).norm() { s } else { e }
             }
         }
+    }
+}
+
+/// The worst place where the straight moves of the offset paths come near an input contour.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Gouge {
+    /// Largest depth by which a move comes closer than R to an input contour (mm; 0 if none).
+    pub depth: f64,
+    /// Output path and index of the move's end point where it happens.
+    pub at: (usize, usize),
+    /// Input path it comes near.
+    pub input: usize,
+}
+
+/// A contour as the check sees it: points in order (closed ones repeat their first at the end)
+/// with the tool axis of each point.
+pub struct Track<'a> {
+    /// Points.
+    pub pts: &'a [P3],
+    /// Unit tool axis per point.
+    pub axes: &'a [V3],
+}
+
+/// The gouge check of a whole 3D result: every move between consecutive output points against
+/// every input segment of every pass (the per-row windows see only the contour near their own
+/// row, not a neighbouring island or the far side of a narrow bay), measured exactly as the
+/// distance between the two segments in the plane perpendicular to the tool axis at either end
+/// of the move (the smaller of the two). Input segments farther than R + the move's length from
+/// the move's start in space are skipped: the tool works near its move, and a projection of a far
+/// part of a curved part is not material under the tool.
+pub fn gouge(outputs: &[Track], inputs: &[&[P3]], r: f64) -> Gouge {
+    let moves: Vec<(usize, usize)> =
+        outputs.iter().enumerate().flat_map(|(o, t)| (1..t.pts.len()).map(move |k| (o, k))).collect();
+    moves
+        .par_iter()
+        .map(|&(o, k)| {
+            let t = &outputs[o];
+            let (a, b) = (t.pts[k - 1], t.pts[k]);
+            let reach = r + (b - a).norm();
+            let mut best = Gouge { depth: 0.0, at: (o, k), input: 0 };
+            for (n, inp) in inputs.iter().enumerate() {
+                for w in inp.windows(2) {
+                    if camkit::geom::dist::point_segment(&a, &w[0], &w[1]) > reach {
+                        continue;
+                    }
+                    for axis in [t.axes[k - 1], t.axes[k]] {
+                        let f = Frame::across(a, &axis);
+                        let d = camkit::geom::dist::segment_segment_min(
+                            &f.flat(&a),
+                            &f.flat(&b),
+                            &f.flat(&w[0]),
+                            &f.flat(&w[1]),
+                        );
+                        if r - d > best.depth {
+                            best = Gouge { depth: r - d, at: (o, k), input: n };
+                        }
+                    }
+                }
+            }
+            best
+        })
+        .reduce(Gouge::default, |x, y| if y.depth > x.depth || (y.depth == x.depth && y.at < x.at) { y } else { x })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A move `dy` beside the x axis at height `dz`, with tool axis `axis`, against R = 1.
+    fn depth(dy: f64, dz: f64, axis: V3) -> Gouge {
+        let input = [P3::new(0.0, 0.0, 0.0), P3::new(10.0, 0.0, 0.0)];
+        let pts = [P3::new(2.0, dy, dz), P3::new(8.0, dy, dz)];
+        let axes = [axis, axis];
+        gouge(&[Track { pts: &pts, axes: &axes }], &[&input], 1.0)
+    }
+
+    #[test]
+    fn gouge_is_measured_across_the_tool_axis() {
+        // Beside the line in the plane across the axis: R minus the distance.
+        assert!((depth(0.5, 0.0, V3::z()).depth - 0.5).abs() < 1e-12);
+        assert_eq!(depth(1.0, 0.0, V3::z()).depth, 0.0);
+        assert_eq!(depth(3.0, 0.0, V3::z()).depth, 0.0);
+        // Straight above the line along the axis: the tool's side runs through it.
+        assert!((depth(0.0, 1.0, V3::z()).depth - 1.0).abs() < 1e-12);
+        // The same place with the axis along y: 1 mm away across the axis, no gouge.
+        assert_eq!(depth(0.0, 1.0, V3::y()).depth, 0.0);
+        // Axis tilted 60° from z toward y: the offset 1 mm along z is sin 60° across it.
+        let tilted = V3::new(0.0, 60f64.to_radians().sin(), 60f64.to_radians().cos());
+        assert!((depth(0.0, 1.0, tilted).depth - (1.0 - 60f64.to_radians().sin())).abs() < 1e-12);
     }
 }
