@@ -50,6 +50,32 @@ pub fn positive(v: f64, what: &str) -> Result<f64> {
     }
 }
 
+/// What a filter reads or writes: the toolpath table or G-code, or decided by the input's name.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Kind {
+    /// Decide by the file extension (.nc .ngc .gcode .gco .g .tap .cnc are G-code).
+    Auto,
+    /// The toolpath table (CSV).
+    Table,
+    /// G-code.
+    Gcode,
+}
+
+impl Kind {
+    /// `Auto` decided by the name of `input`; the others as they are.
+    pub fn resolve(self, input: &crate::io::Input) -> Kind {
+        match self {
+            Kind::Auto
+                if matches!(input.extension().as_str(), "nc" | "ngc" | "gcode" | "gco" | "g" | "tap" | "cnc") =>
+            {
+                Kind::Gcode
+            }
+            Kind::Auto => Kind::Table,
+            k => k,
+        }
+    }
+}
+
 /// Prints a warning on stderr (`name: warning: ...`).
 pub fn warn(message: &str) {
     eprintln!("{}: warning: {message}", program());

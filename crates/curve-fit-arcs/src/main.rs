@@ -1,6 +1,6 @@
 //! `curve-fit-arcs`: point streams and G-code to lines and arcs within a proven tolerance.
 
-use camkit::cli::{self, IoArgs, positive};
+use camkit::cli::{self, IoArgs, Kind, positive};
 use camkit::error::{Error, Location, Result};
 use camkit::geom::Plane;
 use camkit::io::{Input, Output, write_atomic};
@@ -12,16 +12,6 @@ use curve_fit_arcs::{Method, Options, Stats, plot, table_runs};
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Instant;
-
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
-enum Kind {
-    /// Decide by the file extension (.nc .ngc .gcode .gco .g .tap .cnc are G-code).
-    Auto,
-    /// The toolpath table (CSV).
-    Table,
-    /// G-code.
-    Gcode,
-}
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
 enum MethodArg {
@@ -152,19 +142,11 @@ fn options(args: &Args) -> Result<Options> {
     })
 }
 
-fn is_gcode_name(input: &Input) -> bool {
-    matches!(input.extension().as_str(), "nc" | "ngc" | "gcode" | "gco" | "g" | "tap" | "cnc")
-}
-
 fn run(args: Args) -> Result<()> {
     let opts = options(&args)?;
     let started = Instant::now();
     let input = Input::open(&args.io.input)?;
-    let from = match args.from {
-        Kind::Auto if is_gcode_name(&input) => Kind::Gcode,
-        Kind::Auto => Kind::Table,
-        k => k,
-    };
+    let from = args.from.resolve(&input);
     let to = if args.to == Kind::Auto { from } else { args.to };
     let bytes_in = input.data.len();
     let mut out = Output::new(args.io.output.as_deref());

@@ -1,6 +1,6 @@
 //! `offset`: gouge-free tool-radius offsets of line/arc contours.
 
-use camkit::cli::{self, IoArgs, positive};
+use camkit::cli::{self, IoArgs, Kind, positive};
 use camkit::contour::OffsetOptions;
 use camkit::contour::offset::Side;
 use camkit::contour::pocket::{Direction, PocketOptions};
@@ -14,16 +14,6 @@ use offset::{Outcome, Up, space};
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Instant;
-
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
-enum Kind {
-    /// Decide by the file extension (.nc .ngc .gcode .tap .cnc are G-code).
-    Auto,
-    /// The toolpath table (CSV).
-    Table,
-    /// G-code (3-axis; moves of the program become the contour).
-    Gcode,
-}
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
 enum ToolArg {
@@ -193,13 +183,7 @@ fn run(args: Args) -> Result<()> {
         return Err(Error::input("--repeat must be at least 1"));
     }
     let input = Input::open(&args.io.input)?;
-    let from = match args.from {
-        Kind::Auto if matches!(input.extension().as_str(), "nc" | "ngc" | "gcode" | "gco" | "g" | "tap" | "cnc") => {
-            Kind::Gcode
-        }
-        Kind::Auto => Kind::Table,
-        k => k,
-    };
+    let from = args.from.resolve(&input);
     let mut table = if from == Kind::Gcode {
         let text = input.text()?.to_string();
         if text.trim().is_empty() {
