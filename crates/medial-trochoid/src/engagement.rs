@@ -99,27 +99,31 @@ impl Cut {
         Cut { radius, pieces, cell, grid }
     }
 
-    /// Engagement (radians) at fraction `t` of piece `i`: the part of the tool circle not
-    /// removed by pieces `0..i` and by piece `i` up to `t`.
-    pub fn engagement(&self, i: usize, t: f64) -> f64 {
+    /// The arcs of the tool circle at `p` removed by pieces `0..before` whose grid cells lie
+    /// within the tool's reach (each piece once, in index order).
+    fn removed_near(&self, p: &P2, before: usize) -> Vec<(f64, f64)> {
         let r = self.radius;
-        let p = self.pieces[i].point_at(t);
         let (x0, y0) = key(self.cell, &P2::new(p.x - r, p.y - r));
         let (x1, y1) = key(self.cell, &P2::new(p.x + r, p.y + r));
         let mut near: Vec<usize> = Vec::new();
         for x in x0..=x1 {
             for y in y0..=y1 {
                 if let Some(v) = self.grid.get(&(x, y)) {
-                    near.extend(v.iter().copied().filter(|&j| j < i));
+                    near.extend(v.iter().copied().filter(|&j| j < before));
                 }
             }
         }
         near.sort_unstable();
         near.dedup();
-        let mut all: Vec<(f64, f64)> = Vec::new();
-        for j in near {
-            all.extend(removed_by(&p, r, &self.pieces[j]).0);
-        }
+        near.iter().flat_map(|&j| removed_by(p, r, &self.pieces[j]).0).collect()
+    }
+
+    /// Engagement (radians) at fraction `t` of piece `i`: the part of the tool circle not
+    /// removed by pieces `0..i` and by piece `i` up to `t`.
+    pub fn engagement(&self, i: usize, t: f64) -> f64 {
+        let r = self.radius;
+        let p = self.pieces[i].point_at(t);
+        let mut all = self.removed_near(&p, i);
         if t > 0.0 {
             all.extend(removed_by(&p, r, &self.pieces[i].sub(0.0, t)).0);
         }
@@ -132,22 +136,7 @@ impl Cut {
     pub fn engagement_after(&self, extra: &[Seg], k: usize, t: f64) -> f64 {
         let r = self.radius;
         let p = extra[k].point_at(t);
-        let (x0, y0) = key(self.cell, &P2::new(p.x - r, p.y - r));
-        let (x1, y1) = key(self.cell, &P2::new(p.x + r, p.y + r));
-        let mut near: Vec<usize> = Vec::new();
-        for x in x0..=x1 {
-            for y in y0..=y1 {
-                if let Some(v) = self.grid.get(&(x, y)) {
-                    near.extend(v.iter().copied());
-                }
-            }
-        }
-        near.sort_unstable();
-        near.dedup();
-        let mut all: Vec<(f64, f64)> = Vec::new();
-        for j in near {
-            all.extend(removed_by(&p, r, &self.pieces[j]).0);
-        }
+        let mut all = self.removed_near(&p, self.pieces.len());
         for e in &extra[..k] {
             all.extend(removed_by(&p, r, e).0);
         }
