@@ -31,6 +31,7 @@ fn engraving_is_compressed_within_tolerance_both_ways() {
                 &tol.to_string(),
                 "--report",
                 "r.json",
+                "--lower-bound",
                 "-o",
                 "out.nc",
             ],
@@ -39,6 +40,10 @@ fn engraving_is_compressed_within_tolerance_both_ways() {
         out.ok();
         let text = w.read("out.nc");
         let r = report(&w, "r.json");
+        // The proved floor of any segmentation lies below what the search wrote, not far below.
+        let floor = r["moves_lower_bound"].as_u64().unwrap();
+        let written = r["output_moves"].as_u64().unwrap();
+        assert!(floor <= written && 2 * floor >= written, "bound {floor}, written {written}");
         let reported = r["largest_deviation_mm"].as_f64().unwrap();
         assert!(reported <= tol, "reported {reported} > {tol}");
         let independent = measured(&src, &text, tol);

@@ -6,6 +6,7 @@
 //! same feed, tool axis and extrusion rate. Each run is cut into pieces ([`segment`]), each piece
 //! fitted as a line or an arc through its end points ([`fit`]) and measured ([`deviation`]).
 
+pub mod bound;
 pub mod deviation;
 pub mod fit;
 pub mod gcode_runs;
@@ -14,6 +15,7 @@ pub mod segment;
 pub mod table_runs;
 
 use camkit::geom::{P3, Plane};
+use rayon::prelude::*;
 
 /// How runs are cut into pieces.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
@@ -119,4 +121,13 @@ fn push_distinct(pts: &mut Vec<P3>, p: P3) -> bool {
     }
     pts.push(p);
     true
+}
+
+/// A certified lower bound on the output moves of any segmentation of the same runs, joints
+/// anywhere ([`bound`]): the moves written outside runs plus each run's bound. Runs are bounded
+/// in parallel; the sum is the same for any thread count.
+pub fn moves_lower_bound(stats: &Stats, runs: &[FittedRun], opts: &Options) -> usize {
+    let fitted: usize = runs.iter().map(|r| r.pieces.len()).sum();
+    let bound: usize = runs.par_iter().map(|r| bound::min_pieces(&r.pts, opts.tol, &opts.planes)).sum();
+    stats.output_moves - fitted + bound
 }

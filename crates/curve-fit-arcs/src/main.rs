@@ -77,6 +77,10 @@ struct Args {
     /// (inch); tables are written exactly).
     #[arg(long, value_name = "N")]
     decimals: Option<u32>,
+    /// Also prove a lower bound on the moves of any segmentation of the same runs within --tol,
+    /// joints anywhere (report key moves_lower_bound; slower than the fit itself).
+    #[arg(long)]
+    lower_bound: bool,
     /// Write an SVG of the input points and the fitted lines and arcs.
     #[arg(long, value_name = "FILE")]
     svg: Option<PathBuf>,
@@ -207,7 +211,11 @@ fn run(args: Args) -> Result<()> {
         write_atomic(path, plot::plot(&runs, plane, &title).to_svg(1000.0).as_bytes())?;
     }
     if let Some(path) = &args.io.report {
-        report(&stats, &opts, seconds, bytes_in, out.buf.len()).write(path)?;
+        let mut r = report(&stats, &opts, seconds, bytes_in, out.buf.len());
+        if args.lower_bound {
+            r.set("moves_lower_bound", curve_fit_arcs::moves_lower_bound(&stats, &runs, &opts));
+        }
+        r.write(path)?;
     }
     out.commit()
 }
