@@ -293,7 +293,7 @@ fn arc_about(
         return none;
     }
     let helix = Helix { plane, start: a, end: b, centre, ccw: turn > 0.0 };
-    if !deviation::sweep_within(&helix, &V2::new(opts.max_sweep.cos(), opts.max_sweep.sin())) {
+    if !deviation::sweep_within(&helix, &opts.max_sweep.dir) {
         return none;
     }
     if let Some(t) = job.tangent.as_ref()

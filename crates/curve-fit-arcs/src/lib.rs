@@ -27,6 +27,22 @@ pub enum Method {
     Paper,
 }
 
+/// A largest sweep of an arc, kept with its direction (cos, sin): every arc tried is compared
+/// with it, and the comparison needs no trigonometry.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Sweep {
+    /// The angle's unit direction relative to +x, counter-clockwise.
+    pub dir: camkit::geom::V2,
+}
+
+impl Sweep {
+    /// The sweep of `deg` degrees.
+    pub fn degrees(deg: f64) -> Sweep {
+        let angle = deg.to_radians();
+        Sweep { dir: camkit::geom::V2::new(angle.cos(), angle.sin()) }
+    }
+}
+
 /// Settings of a fit.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Options {
@@ -40,8 +56,8 @@ pub struct Options {
     pub min_radius: f64,
     /// Largest arc radius written (mm); flatter runs become lines.
     pub max_radius: f64,
-    /// Largest angle one arc may sweep (radians).
-    pub max_sweep: f64,
+    /// Largest angle one arc may sweep.
+    pub max_sweep: Sweep,
     /// Tangent continuity between pieces: largest change of direction at a joint (radians).
     pub tangent: Option<f64>,
     /// Turning angle (radians) above which a point is a corner no piece spans.
@@ -60,7 +76,7 @@ impl Default for Options {
             planes: vec![Plane::Xy],
             min_radius: 0.0,
             max_radius: 10_000.0,
-            max_sweep: 350f64.to_radians(),
+            max_sweep: Sweep::degrees(350.0),
             tangent: None,
             corner: 60f64.to_radians(),
             curvature_threshold: 1e-3,

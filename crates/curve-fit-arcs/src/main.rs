@@ -8,7 +8,7 @@ use camkit::report::Report;
 use camkit::table::{self, Col, WriteOptions};
 use clap::{Parser, ValueEnum};
 use curve_fit_arcs::gcode_runs::{self, Format};
-use curve_fit_arcs::{Method, Options, Stats, plot, table_runs};
+use curve_fit_arcs::{Method, Options, Stats, Sweep, plot, table_runs};
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Instant;
@@ -138,7 +138,7 @@ fn options(args: &Args) -> Result<Options> {
         planes,
         min_radius: args.min_radius,
         max_radius: args.max_radius,
-        max_sweep: args.max_sweep.to_radians(),
+        max_sweep: Sweep::degrees(args.max_sweep),
         tangent: args.tangent.map(f64::to_radians),
         corner: positive(args.corner, "--corner")?.to_radians(),
         curvature_threshold: positive(args.curvature_threshold, "--curvature-threshold")?,
