@@ -157,3 +157,62 @@ fn wall_pass_corners_are_rounded_and_their_rest_named() {
     w.run(BIN, &[sq, "--radius", "5", "--derate", "1.5"], b"").fails(2, "--derate");
     w.run(BIN, &[sq, "--radius", "5", "--corner-radius", "-1"], b"").fails(2, "--corner-radius");
 }
+
+#[test]
+fn a_given_toolpath_is_analysed_against_closed_forms() {
+    let w = Work::new();
+    let src = data("medial-trochoid/square.csv");
+    let sq = src.to_str().unwrap();
+    // A straight slot down the middle of the 60 × 40 pocket, entered by a ramp from z = 5.
+    w.write(
+        "slot.csv",
+        "path,move,x,y,z,tag\n1,rapid,10,20,5,air\n1,line,20,20,0,ramp\n1,line,50,20,0,cut\n1,rapid,50,20,5,air\n",
+    );
+    let args = [sq, "--radius", "5", "--sample", "0.5", "--analyse", "slot.csv", "--report", "s.json", "-o", "s.csv"];
+    w.run(BIN, &args, b"").ok();
+    let s = report(&w, "s.json");
+    let f = |r: &serde_json::Value, k: &str| r[k].as_f64().unwrap_or_else(|| panic!("{k} in {r}"));
+    // A slot is half the circle, everywhere along it (60 samples at 0.5 mm).
+    assert!((f(&s, "largest_engagement_deg") - 180.0).abs() < 1e-9, "{s}");
+    assert_eq!(s["samples_over_threshold"], 60);
+    assert!((f(&s, "length_mm") - (30.0 + 10.0)).abs() < 1e-9);
+    assert!((f(&s, "entry_length_mm") - 10.0).abs() < 1e-9);
+    assert_eq!(s["chains"], 1);
+    assert_eq!(s["no_gouge"], true);
+    assert!((f(&s, "smallest_wall_clearance_mm") - 10.0).abs() < 1e-9);
+    // Feed model: 180° is the slot feed, chip 0.03 mm × 6 teeth × 4 800 min⁻¹ = 864 mm/min,
+    // for the ramp and the slot alike.
+    assert!((f(&s, "minutes") - 40.0 / 864.0).abs() < 1e-9, "{s}");
+    // A wall pass along y = 5, then a side cut of radial depth a: acos(1 − a/R) along its middle.
+    for a in [0.5f64, 1.17, 2.0, 4.0] {
+        let y = 5.0 + a;
+        w.write(
+            "side.csv",
+            format!("path,move,x,y,z\n1,rapid,5,5,0\n1,line,55,5,0\n2,rapid,55,{y},0\n2,line,5,{y},0\n"),
+        );
+        let args = [sq, "--radius", "5", "--sample", "1", "--analyse", "side.csv", "--report", "r.json", "-o", "t.csv"];
+        w.run(BIN, &args, b"").ok();
+        let r = report(&w, "r.json");
+        assert_eq!(r["chains"], 2);
+        let exact = (1.0 - a / 5.0).acos().to_degrees();
+        let out = rows(&w.read("t.csv"));
+        let mid: Vec<f64> =
+            out.iter().filter(|r| (r.3 - y).abs() < 1e-9 && r.2 > 15.0 && r.2 < 45.0).filter_map(|r| r.1).collect();
+        assert_eq!(mid.len(), 29, "{out:?}");
+        for e in mid {
+            assert!((e - exact).abs() <= 5e-4, "a {a}: {e} vs {exact}");
+        }
+    }
+    // A pass 2 mm closer to the wall than the tool's radius is a gouge.
+    w.write("gouge.csv", "path,move,x,y,z\n1,rapid,10,3,0\n1,line,50,3,0\n");
+    w.run(BIN, &[sq, "--radius", "5", "--analyse", "gouge.csv", "--report", "g.json", "-o", "g.csv"], b"").ok();
+    let g = report(&w, "g.json");
+    assert_eq!(g["no_gouge"], false);
+    assert!((f(&g, "smallest_wall_clearance_mm") - 3.0).abs() < 1e-9);
+    // Bad rows of the analysed table are named with their place.
+    w.write("bad.csv", "path,move,x,y,z\n1,rapid,10,20,0\n1,line,ten,20,0\n");
+    w.run(BIN, &[sq, "--radius", "5", "--analyse", "bad.csv", "-o", "b.csv"], b"").fails(2, "bad.csv:3");
+    w.write("arc.csv", "path,move,x,y,z,xc,yc\n1,rapid,10,20,0,,\n1,ccw,20,20,0,16,20\n");
+    w.run(BIN, &[sq, "--radius", "5", "--analyse", "arc.csv", "-o", "b.csv"], b"").fails(2, "arc.csv:3");
+    assert!(!w.exists("b.csv"));
+}

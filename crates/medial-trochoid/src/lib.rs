@@ -11,6 +11,7 @@ pub mod angles;
 pub mod corner;
 pub mod engagement;
 pub mod feed;
+pub mod given;
 pub mod medial;
 pub mod plot;
 pub mod program;

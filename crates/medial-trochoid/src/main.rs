@@ -3,6 +3,7 @@
 
 use camkit::cli::{self, IoArgs, positive};
 use camkit::contour::Seg;
+use camkit::contour::region::Region;
 use camkit::contour::table as contour_table;
 use camkit::error::{Error, Location, Result};
 use camkit::geom::{P2, P3};
@@ -113,6 +114,12 @@ struct Args {
     /// SVG of the other program (offset-only when writing trochoids, and the reverse).
     #[arg(long, value_name = "FILE")]
     svg_other: Option<PathBuf>,
+    /// Analyse this given toolpath table (another program's, e.g. FreeCAD's adaptive clearing)
+    /// in the pocket of INPUT instead of planning: its lowest z is the layer, its engagement is
+    /// re-simulated at --sample and timed by the same feed model; writes it with the
+    /// engagement column.
+    #[arg(long, value_name = "FILE")]
+    analyse: Option<PathBuf>,
 }
 
 fn after_help() -> String {
@@ -197,6 +204,9 @@ fn run(args: Args) -> Result<()> {
         return Err(Error::input("no closed contour in the input").at(Location::file(&name)));
     }
     let (regions, _turned) = contour_table::pocket_regions(&sources, &name)?;
+    if let Some(given) = &args.analyse {
+        return analyse_given(given, &regions, &settings, &args, started);
+    }
     let plan = plan(&regions, &settings).map_err(|e| match e {
         medial_trochoid::PlanError::Pocket(_) => Error::check(e.to_string()),
         _ => Error::input(e.to_string()).at(Location::file(&name)),
@@ -302,6 +312,72 @@ fn run(args: Args) -> Result<()> {
             .set("output_rows", out_table.rows.len())
             .set("seconds", started.elapsed().as_secs_f64());
         rep.write(path)?;
+    }
+    out.commit()
+}
+
+/// The `--analyse` mode: the given toolpath re-simulated in `regions`, written with its
+/// engagement, and its figures in the report.
+fn analyse_given(
+    path: &std::path::Path,
+    regions: &[Region],
+    s: &Settings,
+    args: &Args,
+    started: Instant,
+) -> Result<()> {
+    let input = Input::open(&path.to_string_lossy())?;
+    let name = input.name.clone();
+    let table = table::read(&input, &[Col::X, Col::Y, Col::Z])?;
+    let given = medial_trochoid::given::read(&table, &name)?;
+    if given.program.moves.is_empty() {
+        return Err(
+            Error::input("no feed move at the toolpath's lowest z: nothing to analyse").at(Location::file(&name))
+        );
+    }
+    let a = medial_trochoid::analyse(given.program.clone(), s, regions);
+    let out_table = to_table(&a, given.depth, 1, 0.0);
+    let mut out = Output::new(args.io.output.as_deref());
+    table::write(&mut out, &out_table, &WriteOptions { decimals: args.decimals })?;
+    if let Some(svg) = &args.svg {
+        let title = format!(
+            "{name}: given toolpath, largest engagement {:.1}° (threshold {}°), {:.2} min",
+            a.max_cutting, s.threshold, a.minutes
+        );
+        write_atomic(svg, plot::given_plot(&title, regions, &a).to_svg(1000.0).as_bytes())?;
+    }
+    if let Some(report) = &args.io.report {
+        let roundoff = medial_trochoid::ENGAGEMENT_ROUNDOFF_DEG;
+        let mut rep = Report::new("medial-trochoid");
+        rep.set("program", "given")
+            .set("analysed", name.as_str())
+            .set("radius_mm", s.radius)
+            .set("threshold_deg", s.threshold)
+            .set("allowance_mm", s.allowance)
+            .set("sample_mm", s.sample)
+            .set("depth_mm", given.depth)
+            .set("moves", a.program.moves.len())
+            .set("chains", given.chains)
+            .set("samples", a.samples.len())
+            .set("largest_engagement_deg", a.max_cutting)
+            .set("link_engagement_deg", a.max_link)
+            .set("entry_engagement_deg", a.max_entry)
+            .set("samples_over_threshold", a.over)
+            .set("link_samples_over_threshold", a.over_links)
+            .set("threshold_held", a.max_cutting <= s.threshold + roundoff)
+            .set("length_mm", a.program.moves.iter().map(|m| m.seg.length()).sum::<f64>())
+            .set("entry_length_mm", a.program.length(Tag::Entry))
+            .set("air_length_mm", given.air_length)
+            .set("smallest_wall_clearance_mm", a.wall_clearance)
+            .set("no_gouge", a.wall_clearance >= s.radius + s.allowance - camkit::tol::OFFSET_TOL)
+            .set("minutes", a.minutes)
+            .set("constant_feed_minutes", a.minutes_constant)
+            .set("derate_above_deg", s.feed.derate_above)
+            .set("derate", s.feed.derate)
+            .set("underated_minutes", a.minutes_underated)
+            .set("constant_feed_underated_minutes", a.minutes_constant_underated)
+            .set("output_rows", out_table.rows.len())
+            .set("seconds", started.elapsed().as_secs_f64());
+        rep.write(report)?;
     }
     out.commit()
 }

@@ -3,6 +3,7 @@
 
 use crate::{Analysed, Plan};
 use camkit::contour::Seg;
+use camkit::contour::region::Region;
 use camkit::geom::P2;
 use camkit::svg::{Aspect, Piece, Plot, Style, ramp};
 
@@ -40,10 +41,9 @@ fn coloured(p: &mut Plot, a: &Analysed, width: f64) {
     }
 }
 
-/// The plot of one program of the plan (`trochoidal` or offset-only).
-pub fn plan_plot(title: &str, plan: &Plan, trochoidal: bool) -> Plot {
-    let mut p = Plot::new(title, Aspect::Equal);
-    for r in &plan.regions {
+/// The contours of `regions` in black.
+fn contours(p: &mut Plot, regions: &[Region]) {
+    for r in regions {
         for c in r.loops() {
             if let Some(first) = c.vertices.first() {
                 let pieces = c
@@ -57,6 +57,22 @@ pub fn plan_plot(title: &str, plan: &Plan, trochoidal: bool) -> Plot {
             }
         }
     }
+}
+
+/// The plot of a given (analysed) toolpath in its pocket, coloured by engagement.
+pub fn given_plot(title: &str, regions: &[Region], a: &Analysed) -> Plot {
+    let mut p = Plot::new(title, Aspect::Equal);
+    contours(&mut p, regions);
+    coloured(&mut p, a, 0.8);
+    p.legend("contour", Style::stroke("black", 1.6))
+        .legend("path: engagement 0° (dark) to 180° (yellow), 15° bands", Style::stroke(&colour(90.0), 0.8));
+    p
+}
+
+/// The plot of one program of the plan (`trochoidal` or offset-only).
+pub fn plan_plot(title: &str, plan: &Plan, trochoidal: bool) -> Plot {
+    let mut p = Plot::new(title, Aspect::Equal);
+    contours(&mut p, &plan.regions);
     let a = if trochoidal { &plan.trochoidal } else { &plan.offset_only };
     coloured(&mut p, a, 0.8);
     for m in &plan.medial {

@@ -1,0 +1,39 @@
+#!/usr/bin/env bash
+# medial-trochoid against FreeCAD's adaptive clearing on the box-die cavity, one layer, φ10:
+# our trochoids-first and offset-only programs, and FreeCAD 0.20's Adaptive2d (driven by
+# scripts/freecad-adaptive.py) at the step over whose straight side cut is our 40° threshold
+# (11.82 % of the diameter: Adaptive2d keeps the cut area per mm of travel at
+# 2·f·A_ref/R, A_ref the crescent a disk sweeps advancing R/2 = 0.98948 R², so a side cut of
+# width a = 1.97897 f R; R(1 − cos 40°) gives f = 0.11822) and at 4 % (a third of it). Every
+# program is re-simulated by `medial-trochoid --analyse` (same exact engagement at the same 1 mm
+# sample step, same feed model and gouge check); our own program is analysed too as a
+# cross-check of the mode against the planner's figures. Needs `apt-get install freecad`.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+TARGET=${CARGO_TARGET_DIR:-target}
+cargo build --release -q -p medial-trochoid --bins
+B="$TARGET/release/medial-trochoid"
+SRC=data/medial-trochoid/box-die.csv
+COMMON=(--radius 5 --sample 1 --trochoid-radius 2.5 --derate 0.5)
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+uptime
+field() { python3 -c "import json,sys; r=json.load(open(sys.argv[1])); print(' '.join(f'{k}={r[k]:.6g}' if isinstance(r[k], float) else f'{k}={r[k]}' for k in sys.argv[2:]))" "$@"; }
+"$B" "$SRC" "${COMMON[@]}" --report "$tmp/ours.json" -o "$tmp/ours.csv"
+echo "ours (plan, both programs): $(field "$tmp/ours.json" largest_engagement_deg samples_over_threshold link_samples_over_threshold trochoid_length_mm contour_length_mm trochoidal_minutes trochoidal_underated_minutes trochoidal_constant_feed_minutes offset_only_largest_engagement_deg offset_only_samples_over_threshold offset_only_length_mm offset_only_minutes offset_only_underated_minutes offset_only_variable_feed_minutes no_gouge seconds)"
+"$B" "$SRC" "${COMMON[@]}" --analyse "$tmp/ours.csv" --report "$tmp/ours-a.json" -o "$tmp/ours-a.csv"
+echo "ours trochoids first, analysed: $(field "$tmp/ours-a.json" largest_engagement_deg samples_over_threshold link_samples_over_threshold length_mm minutes underated_minutes constant_feed_minutes constant_feed_underated_minutes smallest_wall_clearance_mm seconds)"
+"$B" "$SRC" "${COMMON[@]}" --program offset --report "$tmp/off.json" -o "$tmp/off.csv"
+"$B" "$SRC" "${COMMON[@]}" --analyse "$tmp/off.csv" --report "$tmp/off-a.json" -o "$tmp/off-a.csv"
+echo "ours offset only, analysed: $(field "$tmp/off-a.json" largest_engagement_deg samples_over_threshold length_mm minutes underated_minutes constant_feed_minutes constant_feed_underated_minutes smallest_wall_clearance_mm)"
+for step in 11.82 4; do
+  python3 scripts/freecad-adaptive.py "$SRC" "$tmp/fc.csv" --diameter 10 --stepover "$step" --stock 0 0 100 100 --top 60
+  "$B" "$SRC" "${COMMON[@]}" --analyse "$tmp/fc.csv" --report "$tmp/fc.json" -o "$tmp/fc-a.csv"
+  echo "freecad adaptive $step %, analysed: $(field "$tmp/fc.json" largest_engagement_deg samples_over_threshold length_mm entry_length_mm minutes underated_minutes constant_feed_minutes constant_feed_underated_minutes smallest_wall_clearance_mm seconds)"
+  python3 - "$tmp/fc-a.csv" <<'PY'
+import csv, sys
+e = sorted(float(r["engagement"]) for r in csv.DictReader(open(sys.argv[1])) if r["engagement"] and r["tag"] != "entry")
+n = len(e)
+print("  engagement percentiles 50/90/99/100:", [round(e[int(q * (n - 1))], 1) for q in (0.5, 0.9, 0.99, 1.0)])
+PY
+done
