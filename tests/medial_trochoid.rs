@@ -216,3 +216,39 @@ fn a_given_toolpath_is_analysed_against_closed_forms() {
     w.run(BIN, &[sq, "--radius", "5", "--analyse", "arc.csv", "-o", "b.csv"], b"").fails(2, "arc.csv:3");
     assert!(!w.exists("b.csv"));
 }
+
+#[test]
+fn box_die_whole_program_holds_the_threshold_links_included() {
+    let w = Work::new();
+    let src = data("medial-trochoid/box-die.csv");
+    let args = [
+        src.to_str().unwrap(),
+        "--radius",
+        "5",
+        "--sample",
+        "1",
+        "--trochoid-radius",
+        "2.5",
+        "--report",
+        "r.json",
+        "-o",
+        "t.csv",
+    ];
+    w.run(BIN, &args, b"").ok();
+    let r = report(&w, "r.json");
+    // Passes, loops and links: nothing over 40° but the named round-off of a 40° side cut.
+    assert!(r["largest_engagement_deg"].as_f64().unwrap() <= 40.0 + 1e-5, "{r}");
+    assert!(r["link_engagement_deg"].as_f64().unwrap() <= 40.0 + 1e-5, "{r}");
+    assert_eq!(r["samples_over_threshold"], 0);
+    assert_eq!(r["link_samples_over_threshold"], 0);
+    assert_eq!(r["no_gouge"], true);
+    // The step-over link into the neck's pass met uncut material: that pass now starts where a
+    // standing tool has no material on its circle.
+    assert!(r["relinked"].as_u64().unwrap() >= 1, "{r}");
+    for e in r["relink_standing_engagement_deg"].as_array().unwrap() {
+        assert!(e.as_f64().unwrap() <= 1e-9, "{r}");
+    }
+    let out = rows(&w.read("t.csv"));
+    let worst = out.iter().filter(|(t, ..)| t != "entry").filter_map(|r| r.1).fold(0.0, f64::max);
+    assert!(worst <= 40.0005, "{worst}");
+}

@@ -131,6 +131,14 @@ impl Cut {
         (TAU - all.iter().map(|(a, b)| b - a).sum::<f64>()).max(0.0)
     }
 
+    /// Engagement (radians) of a tool standing at `p` after pieces `0..before`: the part of its
+    /// circle in material they left.
+    pub fn engagement_at(&self, p: &P2, before: usize) -> f64 {
+        let mut all = self.removed_near(p, before);
+        merge(&mut all);
+        (TAU - all.iter().map(|(a, b)| b - a).sum::<f64>()).max(0.0)
+    }
+
     /// Engagement (radians) at fraction `t` of `extra[k]`, pieces cut after all of `self`:
     /// the part of the tool circle not removed by `self`, `extra[..k]` and `extra[k]` up to `t`.
     pub fn engagement_after(&self, extra: &[Seg], k: usize, t: f64) -> f64 {

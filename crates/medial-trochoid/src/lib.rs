@@ -15,6 +15,7 @@ pub mod given;
 pub mod medial;
 pub mod plot;
 pub mod program;
+pub mod relink;
 pub mod trochoid;
 
 use camkit::contour::OffsetOptions;
@@ -111,12 +112,17 @@ pub struct Plan {
     pub danger_samples: usize,
     /// Rest material at the wall passes' rounded inside corners, left to finishing.
     pub rests: Vec<corner::Rest>,
+    /// Links of the trochoids-first program that went over the threshold, replaced.
+    pub relinks: Vec<relink::Relink>,
 }
 
 /// Round-off of a computed engagement (degrees): a side cut at exactly the threshold's step
 /// over computes to the threshold within this (measured: 1.2e-6° where a rounded corner's
 /// line meets the previous pass's band tangentially).
 pub const ENGAGEMENT_ROUNDOFF_DEG: f64 = 1e-5;
+
+/// Most links over the threshold a plan replaces (each takes a re-simulation of the program).
+const RELINK_ROUNDS: usize = 16;
 
 /// How many loop radii a plan tries: the given one and its shrinkings by [`LEVEL_RATIO`].
 const LEVELS: usize = 13;
@@ -351,7 +357,27 @@ pub fn plan(regions: &[Region], s: &Settings) -> Result<Plan, PlanError> {
         }
         first = false;
     }
-    let trochoidal = analyse(troch, s, regions);
+    let mut trochoidal = analyse(troch, s, regions);
+    // Links over the threshold: their passes started on cleared ground instead (one link a
+    // round, re-simulated each time; a second round on the same link makes it a retract).
+    let mut relinks = Vec::new();
+    for _ in 0..RELINK_ROUNDS {
+        let limit = s.threshold + ENGAGEMENT_ROUNDOFF_DEG;
+        let Some(i) = trochoidal
+            .samples
+            .iter()
+            .zip(&trochoidal.engagement)
+            .find(|((i, _), e)| trochoidal.program.moves[*i].tag == Tag::Link && **e > limit)
+            .map(|((i, _), _)| *i)
+        else {
+            break;
+        };
+        let Some((p, how)) = relink::relink(&trochoidal.program, i, s.radius, wall, s.sample, regions) else {
+            break;
+        };
+        relinks.push(how);
+        trochoidal = analyse(p, s, regions);
+    }
     Ok(Plan {
         regions: regions.to_vec(),
         passes,
@@ -363,6 +389,7 @@ pub fn plan(regions: &[Region], s: &Settings) -> Result<Plan, PlanError> {
         uncleared,
         danger_samples: hot.len(),
         rests,
+        relinks,
     })
 }
 
