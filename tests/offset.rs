@@ -583,3 +583,27 @@ fn a_closed_self_crossing_contour_is_offset_on_request_to_what_can_be_cut() {
         assert!((polygon_distance(&p, &bow) - 1.0).abs() <= TOL, "{p}");
     }
 }
+
+#[test]
+fn a_kernel_debug_assertion_never_reaches_the_user() {
+    // A regular 63-gon of radius 1 offset inward by 0.9 trips cavalier_contours' debug assertion
+    // (pline_view.rs:353) in debug builds, as these tests run: the offset is retried, verified,
+    // and nothing but the result is written (no panic message on stderr).
+    let w = Work::new();
+    let gon: Vec<P2> = (0..63).map(|k| TAU * k as f64 / 63.0).map(|a| P2::new(a.cos(), a.sin())).collect();
+    w.write("gon.csv", format!("{HEAD}{}", polygon_csv(0, &gon)));
+    for args in
+        [&["gon.csv", "--radius", "0.9", "--side", "left"][..], &["gon.csv", "--radius", "0.9", "--repeat", "1"]]
+    {
+        let out = w.run(BIN, args, b"");
+        assert!(!out.stderr.contains("panick") && !out.stderr.contains("internal error"), "{}", out.stderr);
+        let ps = paths(&out.ok());
+        assert_eq!(ps.len(), 1);
+        // The same polygon, apothem cos(π/63) − 0.9: its points within its circumradius.
+        let inner = ((PI / 63.0).cos() - 0.9) / (PI / 63.0).cos();
+        for p in samples(&ps[0]) {
+            assert!((polygon_distance(&p, &gon) - 0.9).abs() <= TOL, "{p}");
+            assert!(p.coords.norm() <= inner + TOL, "{p}");
+        }
+    }
+}

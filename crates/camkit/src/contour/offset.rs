@@ -9,6 +9,7 @@ use super::verify::{Check, Defect, SegSet, verify};
 use crate::tol;
 use cavalier_contours::polyline::{PlineOffsetOptions, PlineSource, Polyline, TouchingLoopBehavior};
 use cavalier_contours::shape_algorithms::{Shape, ShapeOffsetOptions};
+use cavalier_contours::static_aabb2d_index::StaticAABB2DIndex;
 use std::fmt;
 
 /// Which side of the direction of travel an offset lies on.
@@ -61,7 +62,8 @@ pub struct Offset {
     pub contours: Vec<Contour>,
     /// What the verification measured.
     pub check: Check,
-    /// Kernel runs until one passed (1 when the first did).
+    /// Kernel runs until one passed (1 when the first did; 0 for a region offset shown empty
+    /// without one).
     pub attempts: usize,
     /// True if the passing run needed the cleaned input.
     pub cleaned: bool,
@@ -87,6 +89,9 @@ impl std::error::Error for OffsetError {}
 /// Epsilons of one kernel run: (equal positions, offset distance validity).
 type Eps = (f64, f64);
 
+/// A spatial index of a contour's pieces, in the order of its vertices.
+type Index = StaticAABB2DIndex<f64>;
+
 /// The epsilons to try, the first from the input's scale: well below its shortest piece, well
 /// above round-off at its size.
 fn ladder(contours: &[&Contour]) -> Vec<Eps> {
@@ -102,6 +107,21 @@ fn ladder(contours: &[&Contour]) -> Vec<Eps> {
             }
         }
     }
+    ladder_for(size, shortest)
+}
+
+/// [`ladder`] of one contour from its pieces as the verification holds them (their bounds are
+/// already known), if it has any.
+fn ladder_of_one(set: &SegSet) -> Option<Vec<Eps>> {
+    let (lo, hi) = set.extent()?;
+    let size = 1.0f64.max((hi - lo).abs().max()).max(lo.coords.abs().max()).max(hi.coords.abs().max());
+    let shortest = set.segs.iter().map(|s| s.length()).filter(|l| *l > 0.0).fold(f64::INFINITY, f64::min);
+    Some(ladder_for(size, shortest))
+}
+
+/// The epsilon ladder for pieces within a box of `size` (mm, at least 1) whose shortest is
+/// `shortest` long.
+fn ladder_for(size: f64, shortest: f64) -> Vec<Eps> {
     let pos = (shortest * 1e-4).clamp(size * 1e-12, 1e-5);
     let scaled = (pos, (pos * 10.0).min(1e-6).max(pos));
     let mut out = vec![scaled];
@@ -129,13 +149,20 @@ fn verified(
     side: f64,
     closed: bool,
     opts: &OffsetOptions,
-    kernel: impl Fn(&[Contour], Eps) -> Vec<Contour>,
+    kernel: impl Fn(&[&Contour], Eps, Option<&Index>) -> Vec<Contour>,
 ) -> Result<Offset, OffsetError> {
-    verified_from(input, input, d, side, closed, opts, kernel)
+    verified_from(input, input, d, side, closed, opts, false, kernel)
 }
 
+/// Cells of the quadtree that may show an inward region offset empty before the kernel runs.
+const COVER_BUDGET: usize = 1024;
+
 /// As [`verified`], but the kernel offsets `source` (loops already offset from `input`) while
-/// the result is verified against `input` at distance `d`.
+/// the result is verified against `input` at distance `d`. With `inward`, the region inside
+/// `input` is first tried for a cheap proof that it has no point `d − tol` from its loops
+/// ([`SegSet::covers`]): then no result but none can verify, and none is verified and returned
+/// without a kernel run.
+#[allow(clippy::too_many_arguments)]
 fn verified_from(
     source: &[&Contour],
     input: &[&Contour],
@@ -143,27 +170,41 @@ fn verified_from(
     side: f64,
     closed: bool,
     opts: &OffsetOptions,
-    kernel: impl Fn(&[Contour], Eps) -> Vec<Contour>,
+    inward: bool,
+    kernel: impl Fn(&[&Contour], Eps, Option<&Index>) -> Vec<Contour>,
 ) -> Result<Offset, OffsetError> {
     let set = SegSet::new(input.iter().copied());
-    let original: Vec<Contour> = source.iter().map(|c| (*c).clone()).collect();
+    if inward
+        && set.covers(d - opts.tol - tol::ROUNDOFF_ABS, COVER_BUDGET)
+        && let Ok(check) = verify(&set, &[], d, side, closed, opts.tol, opts.self_crossing_input)
+    {
+        return Ok(Offset { contours: Vec::new(), check, attempts: 0, cleaned: false });
+    }
+    // One contour offset from itself: the verification's index of its pieces (exact boxes, in
+    // the order of its vertices) serves the kernel too, and its pieces give the ladder.
+    let alone = source.len() == 1 && input.len() == 1 && std::ptr::eq(source[0], input[0]);
+    let scale = if alone { ladder_of_one(&set) } else { None }.unwrap_or_else(|| ladder(source));
     let mut attempts = 0;
     let mut defect = None;
-    let scale = ladder(source);
     for was_cleaned in [false, true] {
         let tidy: Vec<Contour>;
-        let loops = if was_cleaned {
+        let tidy_refs: Vec<&Contour>;
+        let (loops, index) = if was_cleaned {
             tidy = source.iter().map(|c| cleaned(c, tol::CLEAN_EPS)).collect();
-            if tidy == original {
+            if tidy.iter().zip(source).all(|(a, b)| a == *b) {
                 continue;
             }
-            &tidy
+            tidy_refs = tidy.iter().collect();
+            (&tidy_refs[..], None)
         } else {
-            &original
+            (source, set.index().filter(|_| alone))
         };
         for &eps in &scale {
             attempts += 1;
-            let mut out = kernel(loops, eps);
+            let Some(mut out) = guarded(|| kernel(loops, eps, index)) else {
+                defect = Some(Defect::Kernel);
+                continue;
+            };
             // A loop no longer than the tolerance is round-off where two loops touch (the lens
             // between two tangent circles): the tool would cut nothing there.
             out.retain(|c| c.length() > opts.tol);
@@ -176,6 +217,31 @@ fn verified_from(
     Err(OffsetError { attempts, defect: defect.expect("at least one attempt") })
 }
 
+thread_local! {
+    /// True while this thread runs the kernel under [`guarded`]: its panics are not reported.
+    static GUARDED: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
+}
+
+/// Runs one kernel call; a panic in it (cavalier_contours' debug assertions stop some runs in
+/// debug builds, e.g. `pline_view.rs:353` on regular polygons) is no result, a failed attempt
+/// that the next epsilons retry, and its message stays off stderr: the panic hook in place is
+/// wrapped, once, to stay silent for panics caught here.
+fn guarded(kernel: impl FnOnce() -> Vec<Contour>) -> Option<Vec<Contour>> {
+    static QUIET_HOOK: std::sync::Once = std::sync::Once::new();
+    QUIET_HOOK.call_once(|| {
+        let previous = std::panic::take_hook();
+        std::panic::set_hook(Box::new(move |info| {
+            if !GUARDED.with(|g| g.get()) {
+                previous(info);
+            }
+        }));
+    });
+    let was = GUARDED.with(|g| g.replace(true));
+    let out = std::panic::catch_unwind(std::panic::AssertUnwindSafe(kernel)).ok();
+    GUARDED.with(|g| g.set(was));
+    out
+}
+
 /// Offsets one contour by `d` (mm, > 0) to `side`, verified. The offset of an open contour is
 /// open pieces; of a closed one, closed loops (which may touch at a vertex), unless it crosses
 /// itself and `opts.self_crossing_input` allows that: then loops and open stretches.
@@ -184,9 +250,10 @@ pub fn offset_contour(c: &Contour, d: f64, side: Side, opts: &OffsetOptions) -> 
     // A closed contour that crosses itself has no side that stays inside: its offset is what the
     // tool can cut on that side, loops and open stretches ending where they would gouge.
     let closed = c.closed && !(opts.self_crossing_input && c.self_crossing().is_some());
-    verified(&[c], d, side.sign(), closed, opts, |source, (pos, dist)| {
+    verified(&[c], d, side.sign(), closed, opts, |source, (pos, dist), index| {
         let pline: Polyline<f64> = source[0].to_pline();
         let o = PlineOffsetOptions {
+            aabb_index: index,
             handle_self_intersects: opts.self_crossing_input,
             pos_equal_eps: pos,
             offset_dist_eps: dist,
@@ -201,7 +268,7 @@ pub fn offset_contour(c: &Contour, d: f64, side: Side, opts: &OffsetOptions) -> 
 /// counter-clockwise around what remains and clockwise around islands.
 pub fn offset_region(region: &Region, d: f64, opts: &OffsetOptions) -> Result<Offset, OffsetError> {
     let loops = region.loops();
-    verified(&loops, d, 1.0, true, opts, |source, (pos, dist)| shape_offset(source, d, (pos, dist)))
+    verified_from(&loops, &loops, d, 1.0, true, opts, true, |source, eps, _| shape_offset(source, d, eps))
 }
 
 /// Offsets `loops` (a region already offset from `input`'s loops, oriented as a region) inward by
@@ -213,7 +280,7 @@ pub fn offset_region_further(
     total: f64,
     opts: &OffsetOptions,
 ) -> Result<Offset, OffsetError> {
-    verified_from(loops, &input.loops(), total, 1.0, true, opts, |source, eps| shape_offset(source, rel, eps))
+    verified_from(loops, &input.loops(), total, 1.0, true, opts, false, |source, eps, _| shape_offset(source, rel, eps))
 }
 
 /// Verifies offsets made elsewhere (another kernel, another run) by the check every result of
@@ -233,14 +300,14 @@ pub fn check_offset(
 /// True if `loops` (oriented as a region) still have something left after an inward offset by
 /// `d`, by one unverified kernel run at the input's own epsilons (a probe, not a result).
 pub fn region_survives(loops: &[&Contour], d: f64) -> bool {
-    let owned: Vec<Contour> = loops.iter().map(|c| (*c).clone()).collect();
-    !shape_offset(&owned, d, ladder(loops)[0]).is_empty()
+    // A run stopped by the kernel's own checks (see [`guarded`]) is retried with the next epsilons.
+    ladder(loops).into_iter().find_map(|eps| guarded(|| shape_offset(loops, d, eps))).is_some_and(|o| !o.is_empty())
 }
 
 /// One run of cavalier's shape offset on loops oriented as a region (outer counter-clockwise,
 /// islands clockwise).
-pub(crate) fn shape_offset(loops: &[Contour], d: f64, (pos, dist): Eps) -> Vec<Contour> {
-    let shape = Shape::from_plines(loops.iter().map(Contour::to_pline));
+pub(crate) fn shape_offset(loops: &[&Contour], d: f64, (pos, dist): Eps) -> Vec<Contour> {
+    let shape = Shape::from_plines(loops.iter().map(|c| c.to_pline()));
     let o = ShapeOffsetOptions { pos_equal_eps: pos, offset_dist_eps: dist, slice_join_eps: dist.max(pos) };
     let out = shape.parallel_offset(d, &o);
     out.ccw_plines.iter().chain(&out.cw_plines).map(|p| Contour::from_pline(&p.polyline)).collect()
@@ -366,6 +433,27 @@ mod tests {
         // Without the permission the crossing is refused by the caller; the kernel alone would
         // find no closed result.
         assert!(offset_contour(&bow, 1.0, Side::Left, &OffsetOptions::default()).is_err());
+    }
+
+    /// A regular 63-gon of radius 1 offset inward by 0.9: cavalier_contours' own debug assertion
+    /// (`pline_view.rs:353`) stops the first run in debug builds; that run is a failed attempt
+    /// and the next epsilons give the closed form (the same polygon, apothem cos(π/63) − 0.9).
+    #[test]
+    fn a_kernel_stopped_by_its_debug_assertion_is_retried_not_a_crash() {
+        let n = 63;
+        let pts: Vec<P2> = (0..n).map(|k| 2.0 * PI * k as f64 / n as f64).map(|a| P2::new(a.cos(), a.sin())).collect();
+        let gon = Contour::polygon(&pts, true);
+        let apothem = (PI / n as f64).cos() - 0.9;
+        let area = n as f64 * apothem * apothem * (PI / n as f64).tan();
+        let o = offset_contour(&gon, 0.9, Side::Left, &OffsetOptions::default()).unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(o.contours.len(), 1);
+        assert!((o.contours[0].area() - area).abs() < 1e-9, "{} vs {area}", o.contours[0].area());
+        assert_eq!(o.attempts > 1, cfg!(debug_assertions), "the first run stops only in debug builds");
+        let (rs, _) = crate::contour::region::regions(std::slice::from_ref(&gon)).unwrap();
+        let o = offset_region(&rs[0], 0.9, &OffsetOptions::default()).unwrap_or_else(|e| panic!("{e}"));
+        assert!((o.contours[0].area() - area).abs() < 1e-9);
+        assert!(region_survives(&[&gon], 0.9) && !region_survives(&[&gon], 1.0));
+        assert_eq!(guarded(|| panic!("a kernel bug")), None);
     }
 
     #[test]

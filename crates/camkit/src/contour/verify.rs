@@ -75,6 +75,9 @@ pub enum Defect {
     Missing(P2),
     /// Output loops cross.
     Crossing(P2),
+    /// The kernel stopped on one of its own internal checks (a debug assertion of
+    /// cavalier_contours) and gave no result.
+    Kernel,
 }
 
 impl Defect {
@@ -88,6 +91,7 @@ impl Defect {
             Defect::WrongSide(p) => format!("an offset piece at {} is on the wrong side", at(p)),
             Defect::Missing(p) => format!("the offset misses the valid point {}", at(p)),
             Defect::Crossing(p) => format!("offset loops cross at {}", at(p)),
+            Defect::Kernel => "the offset kernel stopped on one of its internal checks".into(),
         }
     }
 }
@@ -119,6 +123,8 @@ struct Scratch {
     /// One piece's own candidates, when the group's are too many.
     own: Vec<usize>,
     cands: Vec<(f64, usize)>,
+    /// The input piece that showed the last completeness probe invalid.
+    hit: Option<usize>,
 }
 
 /// Output pieces per block of the piece checks: each block starts without a generator hint.
@@ -289,6 +295,87 @@ impl SegSet {
             return true;
         }
         self.visit(p, p, reach, stack, |i| self.circle_within(i, p, 0.0, reach) && hit(i))
+    }
+
+    /// A piece closer than `reach` to `p`, if any: the pieces `first`, then the index.
+    fn closer(&self, p: &P2, reach: f64, first: &[Option<usize>], stack: &mut Vec<usize>) -> Option<usize> {
+        let hit = |i: usize| self.fast[i].point(p) < reach;
+        if let Some(&i) = first.iter().flatten().find(|&&i| hit(i)) {
+            return Some(i);
+        }
+        let mut found = None;
+        self.visit(p, p, reach, stack, |i| {
+            let yes = self.circle_within(i, p, 0.0, reach) && hit(i);
+            if yes {
+                found = Some(i);
+            }
+            yes
+        });
+        found
+    }
+
+    /// Distance from `p` to the nearest piece, searched nearest first; the search stops at the
+    /// first piece closer than `enough` (then the result is that piece's distance, not the least).
+    fn nearest(&self, p: &P2, enough: f64, queue: &mut NeighborPriorityQueue<f64>) -> f64 {
+        let Some(ix) = &self.index else { return f64::INFINITY };
+        let mut best = f64::INFINITY;
+        let mut visitor = |i: usize, d2: f64| {
+            if d2 >= best * best {
+                return Control::Break(());
+            }
+            best = best.min(self.fast[i].point(p));
+            if best < enough { Control::Break(()) } else { Control::Continue }
+        };
+        let _: Control<()> = ix.visit_neighbors_with_queue(p.x, p.y, &mut visitor, queue);
+        best
+    }
+
+    /// The spatial index of the pieces' boxes (entry `i` is piece `i`), if there are pieces.
+    pub fn index(&self) -> Option<&StaticAABB2DIndex<f64>> {
+        self.index.as_ref()
+    }
+
+    /// The box around every piece, if any.
+    pub fn extent(&self) -> Option<(P2, P2)> {
+        let first = *self.bounds.first()?;
+        Some(self.bounds.iter().fold(first, |(lo, hi), (a, b)| {
+            (P2::new(lo.x.min(a.x), lo.y.min(a.y)), P2::new(hi.x.max(b.x), hi.y.max(b.y)))
+        }))
+    }
+
+    /// True if every point of the box around the pieces lies closer than `reach` to one of them,
+    /// shown by cells of a quadtree (split deepest first) each of whose centre is nearer to a
+    /// piece than `reach` less the cell's half diagonal; false as soon as a cell's centre is
+    /// `reach` or more from every piece, or after `budget` cells. Then no point of the box can
+    /// be `reach` or more from the pieces: an inward offset by more than `reach` is empty.
+    pub fn covers(&self, reach: f64, budget: usize) -> bool {
+        let Some((lo, hi)) = self.extent() else { return false };
+        let mut queue = NeighborPriorityQueue::new();
+        // Cells (centre, half sizes); those to split wait deepest centre first (a distance is
+        // positive, so its bits order as the number does).
+        let mut cells = vec![(P2::from((lo.coords + hi.coords) * 0.5), 0.5 * (hi - lo))];
+        let mut open = std::collections::BinaryHeap::new();
+        let mut fresh = 0..1;
+        loop {
+            for k in fresh.clone() {
+                let (c, half) = cells[k];
+                let h = half.norm();
+                let dist = self.nearest(&c, reach - h, &mut queue);
+                if dist >= reach || cells.len() > budget {
+                    return false;
+                }
+                if dist >= reach - h {
+                    open.push((dist.to_bits(), k));
+                }
+            }
+            let Some((_, k)) = open.pop() else { return true };
+            let (c, half) = cells[k];
+            let q = 0.5 * half;
+            fresh = cells.len()..cells.len() + 4;
+            for (sx, sy) in [(-1.0, -1.0), (1.0, -1.0), (-1.0, 1.0), (1.0, 1.0)] {
+                cells.push((P2::new(c.x + sx * q.x, c.y + sy * q.y), q));
+            }
+        }
     }
 
     /// Side of `q` relative to piece `i` (positive left), deciding at a corner by both pieces
@@ -537,6 +624,10 @@ impl FastArc {
     }
 }
 
+/// What the checks of one block of output pieces found: the largest distance above `d`, the
+/// largest shortfall below it, and the generator of each piece.
+type Block = (f64, f64, Vec<usize>);
+
 /// The settings of one verification.
 #[derive(Clone, Copy)]
 struct Spec {
@@ -687,10 +778,11 @@ fn verify_with(
     }
     let out = SegSet::new(output);
     let starts: Vec<usize> = (0..out.segs.len()).step_by(BLOCK).collect();
-    let blocks: Vec<Result<(f64, f64), Defect>> = starts
+    let blocks: Vec<Result<Block, Defect>> = starts
         .par_iter()
         .map_init(Scratch::default, |scratch, &start| {
             let (mut above, mut below, mut hint) = (0.0f64, 0.0f64, None);
+            let mut generators = Vec::with_capacity(BLOCK);
             for i in start..(start + BLOCK).min(out.segs.len()) {
                 if (i - start) % GROUP == 0 {
                     let group = &out.bounds[i..(i + GROUP).min(start + BLOCK).min(out.segs.len())];
@@ -718,37 +810,53 @@ fn verify_with(
                     above = above.max(a);
                     below = below.max(b);
                     hint = Some(g);
+                    generators.push(g);
                     continue;
                 }
                 let (a, b, g) = check_piece(input, &p, spec, hint, 0, scratch)?;
                 above = above.max(a);
                 below = below.max(b);
                 hint = Some(g);
+                generators.push(g);
             }
-            Ok((above, below))
+            Ok((above, below, generators))
         })
         .collect();
     let mut check = Check { distance: d, pieces: out.segs.len(), ..Check::default() };
+    // The first and last output piece each input piece generated: where the completeness probe
+    // of that input piece looks before searching the output's index.
+    let mut made: Vec<[Option<usize>; 2]> = vec![[None, None]; input.segs.len()];
+    let mut k = 0;
     for block in blocks {
-        let (above, below) = block?;
+        let (above, below, generators) = block?;
         check.above = check.above.max(above);
         check.below = check.below.max(below);
+        for g in generators {
+            made[g][0].get_or_insert(k);
+            made[g][1] = Some(k);
+            k += 1;
+        }
     }
     // Completeness: valid raw offset points of the input's pieces lie on the output (tested in
     // the cheaper order: a point on the output needs no validity test).
     let missing: Option<P2> = (0..input.segs.len())
         .into_par_iter()
-        .map_init(Vec::new, |stack, i| {
+        .map_init(Scratch::default, |scratch, i| {
             let t = &input.segs[i];
             if t.length() <= tol {
                 return None;
             }
             let tangent = t.tangent_at(0.5);
             let c = t.point_at(0.5) + V2::new(-tangent.y, tangent.x) * (spec.side * d);
-            if out.any_within(&c, tol, true, &[], stack) {
+            if out.any_within(&c, tol, true, &made[i], &mut scratch.stack) {
                 return None;
             }
-            let invalid = input.any_within(&c, d - 0.25 * tol, false, &[input.prev[i], input.next[i]], stack);
+            // The piece that showed the previous probe invalid nearly always shows this one too
+            // (the probes of a deep offset lie far from their own pieces).
+            let hit =
+                input.closer(&c, d - 0.25 * tol, &[input.prev[i], input.next[i], scratch.hit], &mut scratch.stack);
+            let invalid = hit.is_some();
+            scratch.hit = hit.or(scratch.hit);
             (!invalid).then_some(c)
         })
         .find_first(|c| c.is_some())
@@ -808,6 +916,24 @@ mod tests {
                 .prop_map(|(a, b, c, d)| Seg::Line(P2::new(a, b), P2::new(c, d))),
             arc().prop_map(Seg::Arc),
         ]
+    }
+
+    #[test]
+    fn covers_proves_a_deep_inward_offset_empty_and_nothing_less() {
+        // A circle of radius 10: its centre is 10 from it, every other point of its box nearer.
+        let circle = Contour::circle(P2::new(3.0, -2.0), 10.0, 0.4, true);
+        let set = SegSet::new([&circle]);
+        assert!(!set.covers(10.0 - 1e-6, 4096));
+        assert!(set.covers(10.0 + 1e-6, 4096));
+        // A 40 × 20 rectangle: its midline is 10 from the long sides. A ridge needs cells as
+        // small as the margin all along it: too few cells give no proof, not a wrong one.
+        let rect =
+            Contour::polygon(&[P2::new(0.0, 0.0), P2::new(40.0, 0.0), P2::new(40.0, 20.0), P2::new(0.0, 20.0)], true);
+        let set = SegSet::new([&rect]);
+        assert!(!set.covers(10.0, 4096));
+        assert!(set.covers(10.5, 4096));
+        assert!(!set.covers(10.0 + 1e-3, 4096));
+        assert!(!set.covers(10.5, 4));
     }
 
     #[test]
@@ -878,6 +1004,33 @@ mod tests {
                 let bound = arc_bound(&sub, &t, (t.start(), t.end())).unwrap();
                 prop_assert!(bound >= exact - 1e-12, "{bound} < {exact}");
                 prop_assert!(bound - exact < 1e-9, "concentric bound {bound} vs exact {exact}");
+            }
+        }
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig { cases: 24, ..ProptestConfig::default() })]
+
+        /// Where `covers` holds, every point of the box (a grid, by brute force over every piece)
+        /// lies nearer than the reach, and the kernel's own verified offset is empty: the proof
+        /// replaces the kernel run exactly.
+        #[test]
+        fn covers_agrees_with_brute_force_and_the_kernel((radii, bulges) in star_parts(), d in 15.0f64..45.0) {
+            let c = star(&radii, &bulges);
+            let set = SegSet::new([&c]);
+            let reach = d - 1e-6;
+            if set.covers(reach, 4096) {
+                let (lo, hi) = set.extent().unwrap();
+                for i in 0..=24 {
+                    for j in 0..=24 {
+                        let q = P2::new(lo.x + (hi.x - lo.x) * i as f64 / 24.0, lo.y + (hi.y - lo.y) * j as f64 / 24.0);
+                        let near = set.segs.iter().map(|s| s.distance_to(&q)).fold(f64::INFINITY, f64::min);
+                        prop_assert!(near < reach, "{q} is {near} from the star");
+                    }
+                }
+                if let Ok(o) = offset_contour(&c, d, Side::Left, &OffsetOptions::default()) {
+                    prop_assert!(o.contours.is_empty(), "the kernel found {} loops", o.contours.len());
+                }
             }
         }
     }
