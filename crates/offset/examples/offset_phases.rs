@@ -38,6 +38,21 @@ fn main() {
     let c = Contour { vertices, closed: true };
     let side = if d > 0.0 { Side::Left } else { Side::Right };
     let opts = OffsetOptions::default();
+    if args.get(4).is_some_and(|s| s == "pocket") {
+        use camkit::contour::pocket::{Direction, Passes, PocketOptions, pocket};
+        let (rs, _) = camkit::contour::region::regions(std::slice::from_ref(&c)).expect("a region");
+        let po = PocketOptions {
+            radius: d.abs(),
+            step: 2.0,
+            passes: Passes::UntilEmpty,
+            direction: Direction::Climb,
+            offset: opts,
+        };
+        let (ms, p) = best(2, || pocket(&rs, &po));
+        let p = p.expect("pocket");
+        println!("pocket: {ms:.1} ms, {} passes, {} kernel runs, {} clean-ups", p.passes.len(), p.attempts, p.clean_ups);
+        return;
+    }
     if args.get(4).is_some_and(|s| s == "levels") {
         let (rs, _) = camkit::contour::region::regions(std::slice::from_ref(&c)).expect("a region");
         let only: Option<f64> = args.get(5).and_then(|s| s.parse().ok());

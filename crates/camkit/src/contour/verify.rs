@@ -237,27 +237,47 @@ impl SegSet {
     /// at a vertex of both (ends within `touch` mm) and nowhere else: loops that come together at
     /// one point and part again, as the offsets of two parts of a contour exactly 2R apart do.
     pub fn first_meeting(&self, touch: f64) -> Option<P2> {
-        (0..self.segs.len())
+        // One search of the index per group of consecutive pieces (the union of their circles'
+        // boxes); a piece that meets piece `i` has a box that meets `i`'s, so it is in the list.
+        let n = self.segs.len();
+        (0..n)
+            .step_by(GROUP)
+            .collect::<Vec<usize>>()
             .into_par_iter()
-            .map_init(Vec::new, |stack, i| {
-                let s = &self.segs[i];
-                let (cs, rs) = self.circles[i];
-                let (lo, hi) = (P2::new(cs.x - rs, cs.y - rs), P2::new(cs.x + rs, cs.y + rs));
-                let mut first: Option<usize> = None;
-                self.visit(&lo, &hi, 0.0, stack, |j| {
-                    if j > i
-                        && first.is_none_or(|f| j < f)
-                        && !self.adjacent(i, j)
-                        && self.circle_within(j, &cs, rs, 0.0)
-                        && s.min_distance(&self.segs[j]) == 0.0
-                        && !(touch > 0.0 && self.touch_at_vertex(i, j, touch))
-                    {
-                        first = Some(j);
-                    }
-                    false
-                });
-                first.map(|j| meeting_point(s, &self.segs[j]))
-            })
+            .map_init(
+                || (Vec::new(), Vec::new()),
+                |(stack, near), start| {
+                    let group = start..(start + GROUP).min(n);
+                    let boxes = group.clone().map(|i| {
+                        let (c, r) = self.circles[i];
+                        (P2::new(c.x - r, c.y - r), P2::new(c.x + r, c.y + r))
+                    });
+                    let (lo, hi) = boxes.reduce(|(lo, hi), (a, b)| {
+                        (P2::new(lo.x.min(a.x), lo.y.min(a.y)), P2::new(hi.x.max(b.x), hi.y.max(b.y)))
+                    })?;
+                    near.clear();
+                    self.visit(&lo, &hi, 0.0, stack, |j| {
+                        near.push(j);
+                        false
+                    });
+                    group.into_iter().find_map(|i| {
+                        let s = &self.segs[i];
+                        let (cs, rs) = self.circles[i];
+                        let first = near
+                            .iter()
+                            .copied()
+                            .filter(|&j| {
+                                j > i
+                                    && !self.adjacent(i, j)
+                                    && self.circle_within(j, &cs, rs, 0.0)
+                                    && s.min_distance(&self.segs[j]) == 0.0
+                                    && !(touch > 0.0 && self.touch_at_vertex(i, j, touch))
+                            })
+                            .min();
+                        first.map(|j| meeting_point(s, &self.segs[j]))
+                    })
+                },
+            )
             .find_first(|p| p.is_some())
             .flatten()
     }
