@@ -50,7 +50,12 @@ fn main() {
         };
         let (ms, p) = best(2, || pocket(&rs, &po));
         let p = p.expect("pocket");
-        println!("pocket: {ms:.1} ms, {} passes, {} kernel runs, {} clean-ups", p.passes.len(), p.attempts, p.clean_ups);
+        println!(
+            "pocket: {ms:.1} ms, {} passes, {} kernel runs, {} clean-ups",
+            p.passes.len(),
+            p.attempts,
+            p.clean_ups
+        );
         return;
     }
     if args.get(4).is_some_and(|s| s == "levels") {
