@@ -107,6 +107,13 @@ fn bad_input_is_refused_with_its_place() {
     let sq = data("medial-trochoid/square.csv");
     w.run(BIN, &[sq.to_str().unwrap(), "--radius", "30"], b"").fails(2, "does not fit");
     w.run(BIN, &[sq.to_str().unwrap(), "--radius", "-1"], b"").fails(2, "--radius");
+    // DXF: a contour that does not close, and a bad number, named with their line.
+    let line = |a: (i32, i32), b: (i32, i32)| format!("0\nLINE\n10\n{}\n20\n{}\n11\n{}\n21\n{}\n", a.0, a.1, b.0, b.1);
+    let body = line((0, 0), (30, 0)) + &line((30, 0), (30, 30)) + &line((30, 30), (0, 30));
+    w.write("open.dxf", format!("0\nSECTION\n2\nENTITIES\n{body}0\nENDSEC\n0\nEOF\n"));
+    w.run(BIN, &["open.dxf", "--radius", "1"], b"").fails(2, "open.dxf:25");
+    w.write("num.dxf", "0\nSECTION\n2\nENTITIES\n0\nCIRCLE\n10\n5\n20\nfive\n40\n2\n0\nENDSEC\n0\nEOF\n");
+    w.run(BIN, &["num.dxf", "--radius", "1"], b"").fails(2, "num.dxf:10");
     w.write("empty.csv", "");
     let out = w.run(BIN, &["empty.csv", "--radius", "1", "-o", "never.csv"], b"");
     assert_eq!(out.status, 2, "{}", out.stderr);
@@ -251,4 +258,9 @@ fn box_die_whole_program_holds_the_threshold_links_included() {
     let out = rows(&w.read("t.csv"));
     let worst = out.iter().filter(|(t, ..)| t != "entry").filter_map(|r| r.1).fold(0.0, f64::max);
     assert!(worst <= 40.0005, "{worst}");
+    // The same cavity drawn in DXF (12 LINEs chained, the boss a CIRCLE) gives the same program.
+    let dxf = data("medial-trochoid/box-die.dxf");
+    let args = [dxf.to_str().unwrap(), "--radius", "5", "--sample", "1", "--trochoid-radius", "2.5", "-o", "d.csv"];
+    w.run(BIN, &args, b"").ok();
+    assert!(w.read("d.csv") == w.read("t.csv"), "DXF and table inputs give different programs");
 }

@@ -9,6 +9,7 @@
 pub mod cli;
 pub mod contour;
 pub mod doc;
+pub mod dxf;
 pub mod error;
 pub mod gcode;
 pub mod geom;

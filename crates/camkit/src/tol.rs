@@ -40,6 +40,10 @@ pub const ARC_END_MISMATCH: f64 = 1e-3;
 /// determine (a sphere from coplanar points) is refused instead of fitted.
 pub const DEGENERATE_SPREAD_REL: f64 = 1e-9;
 
+/// Largest gap (mm) between the ends of two DXF entities that `dxf::read` joins into one contour
+/// (CAD exports leave round-off gaps of this order; the later piece's start is kept).
+pub const DXF_JOIN: f64 = 1e-4;
+
 /// `a` and `b` differ by at most `eps`.
 pub fn near(a: f64, b: f64, eps: f64) -> bool {
     (a - b).abs() <= eps

@@ -33,7 +33,7 @@ enum Which {
     version,
     allow_negative_numbers = true,
     about = "Engagement of contour-parallel pocketing, danger regions on the medial axis, trochoidal clearing first (paper 001).",
-    long_about = "Reads closed contours (outer boundaries and islands; lines and arcs) from the toolpath table, makes \
+    long_about = "Reads closed contours (outer boundaries and islands; lines and arcs) from the toolpath table or a DXF file, makes \
 contour-parallel pocket passes, simulates the material removal to get the exact 2D engagement angle along them, finds \
 where passes over the threshold meet the medial axis (segment Voronoi diagram without the edges at reflex vertices), \
 clears those stretches first with constant-radius trochoidal loops, re-simulates the whole program and estimates both \
@@ -130,6 +130,10 @@ fn after_help() -> String {
     s.push_str("  engagement deg            engagement angle at the row's end (material-removal simulation)\n");
     s.push_str("Each input path is one closed contour; nesting decides outer boundaries and islands.\n");
     s.push_str(
+        "An INPUT named *.dxf is read as ASCII DXF: LINE, ARC, CIRCLE, LWPOLYLINE and POLYLINE entities chained\n",
+    );
+    s.push_str("end to end (gaps up to 1e-4 mm) into closed contours, in mm, z from the entities.\n");
+    s.push_str(
         "Output rows are samples along the tool-centre path (at most --sample mm apart); tag is entry (helical\n",
     );
     s.push_str("entry loop of a trochoid run), trochoid, contour or link; each chain starts with a rapid row.\n");
@@ -195,11 +199,22 @@ fn run(args: Args) -> Result<()> {
     };
     let input = Input::open(&args.io.input)?;
     let name = input.name.clone();
-    let table = table::read(&input, &[Col::X, Col::Y])?;
-    if table.rows.is_empty() {
-        return Err(Error::input("no rows: no contour to pocket").at(Location::file(&name)));
-    }
-    let sources = contour_table::read(&table, &name)?.sources;
+    let sources = if name.to_ascii_lowercase().ends_with(".dxf") {
+        let read = camkit::dxf::read(&name, &String::from_utf8_lossy(&input.data))?;
+        if let Some((kind, line)) = read.skipped.first() {
+            cli::warn(&format!(
+                "{name}: {} entities that are not contours skipped (the first: {kind} at line {line})",
+                read.skipped.len()
+            ));
+        }
+        read.sources
+    } else {
+        let table = table::read(&input, &[Col::X, Col::Y])?;
+        if table.rows.is_empty() {
+            return Err(Error::input("no rows: no contour to pocket").at(Location::file(&name)));
+        }
+        contour_table::read(&table, &name)?.sources
+    };
     if sources.is_empty() {
         return Err(Error::input("no closed contour in the input").at(Location::file(&name)));
     }
