@@ -3,7 +3,9 @@
 //! `time` as a fourth argument the best wall times of the kernel alone, of the verification of
 //! its result and of the whole verified offset.
 //!
-//! `RAYON_NUM_THREADS=1 valgrind --tool=callgrind target/release/examples/offset_phases N lines|arcs D`
+//! `RAYON_NUM_THREADS=1 valgrind --tool=callgrind target/release/examples/offset_phases N lines|arcs D [bare]`
+//! (`bare`: cavalier_contours alone with its default options; `none`: the star alone; `pocket`: a pocket to empty with
+//! radius D and step 2; `levels`: each region offset of such a pocket timed alone).
 
 use camkit::contour::offset::{Side, check_offset, offset_contour};
 use camkit::contour::{Contour, OffsetOptions, Vertex};
@@ -38,6 +40,20 @@ fn main() {
     let c = Contour { vertices, closed: true };
     let side = if d > 0.0 { Side::Left } else { Side::Right };
     let opts = OffsetOptions::default();
+    if args.get(4).is_some_and(|s| s == "none") {
+        // The star alone: the instructions every mode spends before its offset.
+        println!("{} vertices", c.vertices.len());
+        return;
+    }
+    if args.get(4).is_some_and(|s| s == "bare") {
+        // Bare cavalier_contours alone (default options), for its instruction count.
+        let mut p = Polyline::new_closed();
+        for v in &c.vertices {
+            p.add(v.p.x, v.p.y, v.bulge);
+        }
+        println!("{} pieces", p.parallel_offset_opt(d, &PlineOffsetOptions::default()).len());
+        return;
+    }
     if args.get(4).is_some_and(|s| s == "pocket") {
         use camkit::contour::pocket::{Direction, Passes, PocketOptions, pocket};
         let (rs, _) = camkit::contour::region::regions(std::slice::from_ref(&c)).expect("a region");
