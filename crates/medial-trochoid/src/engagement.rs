@@ -77,6 +77,8 @@ pub struct Cut {
     pub radius: f64,
     /// Swept pieces of the tool centre in order.
     pub pieces: Vec<Seg>,
+    /// Bounding box of each piece.
+    boxes: Vec<(P2, P2)>,
     cell: f64,
     grid: HashMap<(i64, i64), Vec<usize>>,
 }
@@ -96,7 +98,8 @@ impl Cut {
                 }
             }
         }
-        Cut { radius, pieces, cell, grid }
+        let boxes = pieces.iter().map(Seg::bounds).collect();
+        Cut { radius, pieces, boxes, cell, grid }
     }
 
     /// The arcs of the tool circle at `p` removed by pieces `0..before` whose grid cells lie
@@ -115,7 +118,18 @@ impl Cut {
         }
         near.sort_unstable();
         near.dedup();
-        near.iter().flat_map(|&j| removed_by(p, r, &self.pieces[j]).0).collect()
+        // A piece whose box is 2R or more from `p` leaves the circle alone: skip it before the
+        // trigonometry (the grid's cells are 2R wide, so most of the pieces found are so).
+        let reach = 2.0 * r;
+        near.iter()
+            .filter(|&&j| {
+                let (lo, hi) = self.boxes[j];
+                let dx = (lo.x - p.x).max(p.x - hi.x).max(0.0);
+                let dy = (lo.y - p.y).max(p.y - hi.y).max(0.0);
+                dx * dx + dy * dy < reach * reach
+            })
+            .flat_map(|&j| removed_by(p, r, &self.pieces[j]).0)
+            .collect()
     }
 
     /// Engagement (radians) at fraction `t` of piece `i`: the part of the tool circle not
