@@ -14,18 +14,8 @@ use cavalier_contours::polyline::{PlineOffsetOptions, PlineSource, PlineSourceMu
 use cavalier_contours::shape_algorithms::{Shape, ShapeOffsetOptions};
 use std::time::Instant;
 
-/// A star of `n` vertices, r = 50 + 15 cos 8θ; arcs of alternating bulge ±0.05 if `arcs`.
-fn star(n: usize, arcs: bool) -> Contour {
-    let vertices = (0..n)
-        .map(|i| {
-            let a = std::f64::consts::TAU * i as f64 / n as f64;
-            let r = 50.0 + 15.0 * (8.0 * a).cos();
-            let bulge = if arcs { if i % 2 == 0 { 0.05 } else { -0.05 } } else { 0.0 };
-            Vertex { p: P2::new(r * a.cos(), r * a.sin()), bulge }
-        })
-        .collect();
-    Contour { vertices, closed: true }
-}
+mod stars;
+use stars::star;
 
 fn pline(c: &Contour) -> Polyline<f64> {
     let mut p = Polyline::new_closed();

@@ -13,6 +13,8 @@ use camkit::geom::P2;
 use cavalier_contours::polyline::{PlineOffsetOptions, PlineSource, PlineSourceMut, Polyline};
 use std::time::Instant;
 
+mod stars;
+
 fn best<R>(runs: usize, mut f: impl FnMut() -> R) -> (f64, R) {
     let mut t = f64::INFINITY;
     let mut r = f();
@@ -29,15 +31,7 @@ fn main() {
     let n: usize = args.get(1).and_then(|s| s.parse().ok()).unwrap_or(1000);
     let arcs = args.get(2).is_some_and(|s| s == "arcs");
     let d: f64 = args.get(3).and_then(|s| s.parse().ok()).unwrap_or(2.0);
-    let vertices = (0..n)
-        .map(|i| {
-            let a = std::f64::consts::TAU * i as f64 / n as f64;
-            let r = 50.0 + 15.0 * (8.0 * a).cos();
-            let bulge = if arcs { if i % 2 == 0 { 0.05 } else { -0.05 } } else { 0.0 };
-            Vertex { p: P2::new(r * a.cos(), r * a.sin()), bulge }
-        })
-        .collect();
-    let c = Contour { vertices, closed: true };
+    let c = stars::star(n, arcs);
     let side = if d > 0.0 { Side::Left } else { Side::Right };
     let opts = OffsetOptions::default();
     if args.get(4).is_some_and(|s| s == "none") {
