@@ -178,11 +178,16 @@ pub fn fit_corners(
     let r = before.radius;
     let corners = inside_corners(c);
     let mut out: Vec<Result<(f64, f64), (f64, f64)>> = Vec::with_capacity(corners.len());
+    // Corner index of each vertex (one lookup per vertex, not a search per vertex per trial).
+    let mut slot = vec![None; c.vertices.len()];
+    for (q, &v) in corners.iter().enumerate() {
+        slot[v] = Some(q);
+    }
     for j in 0..corners.len() {
         let mut best = (0.0, f64::INFINITY);
         let mut found = None;
         for &rho in candidates {
-            let radius = |v: usize| match corners.iter().position(|&w| w == v) {
+            let radius = |v: usize| match slot[v] {
                 Some(q) if q < j => out[q].map_or_else(|e| e.0, |o| o.0),
                 Some(q) if q == j => rho,
                 _ => 0.0,

@@ -120,14 +120,8 @@ impl Cut {
         near.dedup();
         // A piece whose box is 2R or more from `p` leaves the circle alone: skip it before the
         // trigonometry (the grid's cells are 2R wide, so most of the pieces found are so).
-        let reach = 2.0 * r;
         near.iter()
-            .filter(|&&j| {
-                let (lo, hi) = self.boxes[j];
-                let dx = (lo.x - p.x).max(p.x - hi.x).max(0.0);
-                let dy = (lo.y - p.y).max(p.y - hi.y).max(0.0);
-                dx * dx + dy * dy < reach * reach
-            })
+            .filter(|&&j| within_reach(&self.boxes[j], p, 2.0 * r))
             .flat_map(|&j| removed_by(p, r, &self.pieces[j]).0)
             .collect()
     }
@@ -159,7 +153,7 @@ impl Cut {
         let r = self.radius;
         let p = extra[k].point_at(t);
         let mut all = self.removed_near(&p, self.pieces.len());
-        for e in &extra[..k] {
+        for e in extra[..k].iter().filter(|e| within_reach(&e.bounds(), &p, 2.0 * r)) {
             all.extend(removed_by(&p, r, e).0);
         }
         if t > 0.0 {
@@ -185,6 +179,13 @@ impl Cut {
     pub fn profile(&self, samples: &[(usize, f64)]) -> Vec<f64> {
         samples.par_iter().map(|&(i, t)| self.engagement(i, t).to_degrees()).collect()
     }
+}
+
+/// True if the box `(lo, hi)` comes nearer than `reach` to `p`.
+fn within_reach((lo, hi): &(P2, P2), p: &P2, reach: f64) -> bool {
+    let dx = (lo.x - p.x).max(p.x - hi.x).max(0.0);
+    let dy = (lo.y - p.y).max(p.y - hi.y).max(0.0);
+    dx * dx + dy * dy < reach * reach
 }
 
 fn key(cell: f64, p: &P2) -> (i64, i64) {

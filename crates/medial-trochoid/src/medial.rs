@@ -8,7 +8,7 @@
 //! region's centre, within i32 range (±2147 mm at 1e-6 mm). Arcs are flattened into chords
 //! within `sagitta`; parabolic edges (point–segment) are discretised within `chord_error`.
 
-use boostvoronoi::{Builder, Line, Point, SourceCategory};
+use boostvoronoi::prelude::{Builder, CellIndex, Line, Point, SourceCategory, Vertex};
 use camkit::contour::Seg;
 use camkit::contour::region::Region;
 use camkit::geom::{P2, V2, cross2};
@@ -149,32 +149,30 @@ pub fn medial_axis(region: &Region, opts: &MedialOptions) -> Result<Medial, Medi
         }
     }
     let started = Instant::now();
-    let diagram = Builder::<i32, f64>::default()
+    let diagram = Builder::<i32>::default()
         .with_segments(lines.iter().copied())
         .and_then(|b| b.build())
         .map_err(|e| MedialError::Builder(e.to_string()))?;
     // A site of a cell: a segment, or one end point of a segment.
-    let site_of = |cell: boostvoronoi::CellIndex| -> Option<(usize, SourceCategory)> {
-        let c = diagram.get_cell(cell).ok()?.get();
-        Some((c.source_index(), c.source_category()))
+    let site_of = |cell: CellIndex| -> Option<(usize, SourceCategory)> {
+        let c = diagram.cell(cell).ok()?;
+        Some((c.source_index().usize(), c.source_category()))
     };
     let mut out = Medial { segments: sites.len(), build_seconds: started.elapsed().as_secs_f64(), ..Medial::default() };
     for e in diagram.edges() {
-        let e = e.get();
         let id = e.id();
         let Ok(twin) = e.twin() else { continue };
-        if twin.0 < id.0 || !e.is_primary() {
+        if twin.usize() < id.usize() || !e.is_primary() {
             continue;
         }
         let (Some(v0), Ok(Some(v1))) = (e.vertex0(), diagram.edge_get_vertex1(id)) else { continue };
-        let (Ok(v0), Ok(v1)) = (diagram.vertex_get(v0), diagram.vertex_get(v1)) else { continue };
-        let (v0, v1) = (v0.get(), v1.get());
+        let (Ok(v0), Ok(v1)) = (diagram.vertex(v0), diagram.vertex(v1)) else { continue };
         let (p0, p1) = (unsnap(v0.x(), v0.y()), unsnap(v1.x(), v1.y()));
         let (Ok(c0), Ok(c1)) = (e.cell(), diagram.edge_get_cell(twin)) else { continue };
         let (Some(s0), Some(s1)) = (site_of(c0), site_of(c1)) else { continue };
         // Skip the fans from smooth joints (of flattened arcs): not part of the true medial axis.
-        let at_joint = |v: &boostvoronoi::Vertex<f64>| joints.contains(&(v.x().round() as i64, v.y().round() as i64));
-        if at_joint(&v0) || at_joint(&v1) {
+        let at_joint = |v: &Vertex| joints.contains(&(v.x().round() as i64, v.y().round() as i64));
+        if at_joint(v0) || at_joint(v1) {
             continue;
         }
         let geo0 = geometry(&sites, s0);
