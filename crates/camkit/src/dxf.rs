@@ -61,7 +61,7 @@ fn groups<'a>(name: &str, text: &'a str) -> Result<Vec<Group<'a>>> {
 }
 
 fn number(name: &str, g: &Group) -> Result<f64> {
-    g.value.parse::<f64>().ok().filter(|v| v.is_finite()).ok_or_else(|| {
+    crate::num::parse_finite(g.value).map_err(|_| {
         Error::input(format!("group {} needs a number, got {:?}", g.code, g.value))
             .at(Location::file(name).line(g.line + 1))
     })

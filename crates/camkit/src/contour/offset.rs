@@ -97,8 +97,8 @@ type Index = StaticAABB2DIndex<f64>;
 fn ladder(contours: &[&Contour]) -> Vec<Eps> {
     let (mut size, mut shortest) = (1.0f64, f64::INFINITY);
     for c in contours {
-        if let Some((lo, hi)) = c.bounds() {
-            size = size.max((hi - lo).abs().max()).max(lo.coords.abs().max()).max(hi.coords.abs().max());
+        if let Some(b) = c.bounds() {
+            size = size.max(box_size(b));
         }
         for s in c.segs() {
             let l = s.length();
@@ -113,10 +113,15 @@ fn ladder(contours: &[&Contour]) -> Vec<Eps> {
 /// [`ladder`] of one contour from its pieces as the verification holds them (their bounds are
 /// already known), if it has any.
 fn ladder_of_one(set: &SegSet) -> Option<Vec<Eps>> {
-    let (lo, hi) = set.extent()?;
-    let size = 1.0f64.max((hi - lo).abs().max()).max(lo.coords.abs().max()).max(hi.coords.abs().max());
+    let size = 1.0f64.max(box_size(set.extent()?));
     let shortest = set.segs.iter().map(|s| s.length()).filter(|l| *l > 0.0).fold(f64::INFINITY, f64::min);
     Some(ladder_for(size, shortest))
+}
+
+/// The scale round-off works at for pieces in the box `(lo, hi)`: its largest side or
+/// coordinate (mm).
+fn box_size((lo, hi): (crate::geom::P2, crate::geom::P2)) -> f64 {
+    (hi - lo).abs().max().max(lo.coords.abs().max()).max(hi.coords.abs().max())
 }
 
 /// The epsilon ladder for pieces within a box of `size` (mm, at least 1) whose shortest is

@@ -817,23 +817,21 @@ fn verify_with(
                     });
                 }
                 let p = Piece::new(out.segs[i], out.circles[i]);
-                if scratch.near.len() > CROWD {
-                    // Far from the input (a deep pocket level): the box holds much of it, while
-                    // the disc of reach around this piece holds only the pieces nearest to it.
+                // Far from the input (a deep pocket level) the group's box holds much of it,
+                // while the disc of reach around this piece holds only the pieces nearest to it:
+                // the piece is checked against those instead.
+                let crowded = scratch.near.len() > CROWD;
+                if crowded {
                     let Scratch { queue, own, .. } = scratch;
                     own.clear();
                     input.visit_nearest(&p.c, d + tol + p.r, queue, |j| own.push(j));
                     std::mem::swap(&mut scratch.near, &mut scratch.own);
-                    let r = check_piece(input, &p, spec, hint, 0, scratch);
-                    std::mem::swap(&mut scratch.near, &mut scratch.own);
-                    let (a, b, g) = r?;
-                    above = above.max(a);
-                    below = below.max(b);
-                    hint = Some(g);
-                    generators.push(g);
-                    continue;
                 }
-                let (a, b, g) = check_piece(input, &p, spec, hint, 0, scratch)?;
+                let checked = check_piece(input, &p, spec, hint, 0, scratch);
+                if crowded {
+                    std::mem::swap(&mut scratch.near, &mut scratch.own);
+                }
+                let (a, b, g) = checked?;
                 above = above.max(a);
                 below = below.max(b);
                 hint = Some(g);
