@@ -114,9 +114,14 @@ impl Centre {
     /// Width of the thinnest annulus (or strip) about this centre holding `pts`, and the indices
     /// of the innermost and outermost points.
     fn spread(&self, pts: &[P2]) -> (f64, usize, usize) {
+        // A strip's unit normal, once for all points.
+        let normal = match self {
+            Centre::Strip(d) => V2::new(-d.y, d.x).normalize(),
+            Centre::At(_) => V2::zeros(),
+        };
         let key = |p: &P2| match self {
             Centre::At(c) => (p - c).norm(),
-            Centre::Strip(d) => V2::new(-d.y, d.x).normalize().dot(&p.coords),
+            Centre::Strip(_) => normal.dot(&p.coords),
         };
         let (mut lo, mut hi) = ((f64::INFINITY, 0), (f64::NEG_INFINITY, 0));
         for (i, p) in pts.iter().enumerate() {
