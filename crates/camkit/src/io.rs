@@ -27,10 +27,23 @@ impl Input {
 
     /// The input as text; invalid UTF-8 is an input error naming the line.
     pub fn text(&self) -> Result<&str> {
-        std::str::from_utf8(&self.data).map_err(|e| {
-            let line = self.data[..e.valid_up_to()].iter().filter(|&&b| b == b'\n').count() as u64 + 1;
-            Error::input("text is not valid UTF-8").at(crate::error::Location::file(&self.name).line(line))
+        std::str::from_utf8(&self.data).map_err(|e| self.not_utf8(e.valid_up_to()))
+    }
+
+    /// The input as owned text, moved out without a copy (`data` is left empty); invalid UTF-8
+    /// is an input error naming the line (and `data` is kept).
+    pub fn take_text(&mut self) -> Result<String> {
+        String::from_utf8(std::mem::take(&mut self.data)).map_err(|e| {
+            let valid = e.utf8_error().valid_up_to();
+            self.data = e.into_bytes();
+            self.not_utf8(valid)
         })
+    }
+
+    /// The error for text that stops being UTF-8 after `valid` bytes.
+    fn not_utf8(&self, valid: usize) -> Error {
+        let line = self.data[..valid].iter().filter(|&&b| b == b'\n').count() as u64 + 1;
+        Error::input("text is not valid UTF-8").at(crate::error::Location::file(&self.name).line(line))
     }
 
     /// The file extension in lower case (empty for standard input).
@@ -126,6 +139,19 @@ mod tests {
         dropped.write_all(b"partial").unwrap();
         drop(dropped);
         assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
+    }
+
+    #[test]
+    fn taken_text_is_the_input_and_bad_utf8_names_its_line() {
+        let mut good = Input { name: "a.nc".into(), data: b"G1 X1\nG1 X2\n".to_vec() };
+        assert_eq!(good.take_text().unwrap(), "G1 X1\nG1 X2\n");
+        assert!(good.data.is_empty());
+        let mut bad = Input { name: "b.nc".into(), data: b"G1 X1\nG1 X\xff\n".to_vec() };
+        let e = bad.take_text().unwrap_err();
+        assert_eq!(e.exit_status(), 2);
+        assert_eq!(e.to_string(), bad.text().unwrap_err().to_string());
+        assert!(e.to_string().contains("b.nc:2"), "{e}");
+        assert_eq!(bad.data.len(), 12, "the bytes are kept for the message");
     }
 
     #[test]

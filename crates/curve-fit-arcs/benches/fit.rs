@@ -17,7 +17,7 @@ fn gcode(c: &mut Criterion) {
             b.iter(|| {
                 let program = camkit::gcode::read("jsdc", source.clone()).expect("parses");
                 let format = Format::of(&program);
-                black_box(fit_program(&program, &opts, format).expect("fits"))
+                black_box(fit_program(&program, &opts, format, false).expect("fits"))
             })
         });
     }

@@ -80,11 +80,13 @@ fn continues(head: &MoveBlock, m: &MoveBlock, opts: &Options) -> bool {
     }
 }
 
-/// Fits every run of `program` and writes the result.
+/// Fits every run of `program` and writes the result; the fitted runs are returned too when
+/// `keep_runs` (for a plot or the lower bound), otherwise their buffers are reused run to run.
 pub fn fit_program(
     program: &Program,
     opts: &Options,
     format: Format,
+    keep_runs: bool,
 ) -> Result<(Vec<u8>, Stats, Vec<FittedRun>), GcodeError> {
     let mut w = Writer::new(format.decimals, format.centre_decimals, format.e_decimals);
     w.out.reserve(program.source.len());
@@ -93,8 +95,10 @@ pub fn fit_program(
         blocks.iter().map(|b| if let Block::Move(m) = b { Some(m) } else { None }).collect();
     let mut stats = Stats { input_moves: moves.iter().flatten().count(), ..Stats::default() };
     let mut runs = Vec::new();
-    // Block index of each run point (one buffer for all runs).
+    // Points of a run and the block index of each (buffers for all runs).
+    let mut pts: Vec<P3> = Vec::new();
     let mut from: Vec<usize> = Vec::new();
+    let mut scratch = segment::Scratch::default();
     let mut written = 0;
     let mut k = 0;
     while k < blocks.len() {
@@ -117,8 +121,7 @@ pub fn fit_program(
                 _ => break,
             }
         }
-        // At most one point per block of the run, plus its start: reserve once, not per push.
-        let mut pts = Vec::with_capacity(end + 2 - k);
+        pts.clear();
         from.clear();
         pts.push(head.start);
         from.push(k);
@@ -136,9 +139,9 @@ pub fn fit_program(
             continue;
         }
         let rounding = Written { writer: &w, modes: &head.modes };
-        let pieces = segment::segment(&pts, opts, &rounding)
+        let pieces = segment::segment_with(&pts, opts, &rounding, &mut scratch)
             .map_err(|cause| GcodeError { line: line_of(program, from[cause.at + 1]), cause })?;
-        for p in &pieces {
+        for p in pieces {
             // Blocks covered by the piece: from[p.first + 1] ..= from[p.last] (plus dropped repeats).
             let lo = if p.first == 0 { k } else { from[p.first] + 1 };
             let hi = from[p.last];
@@ -180,8 +183,10 @@ pub fn fit_program(
             remarks(&mut w, program, lo, hi);
         }
         stats.points += pts.len();
-        stats.add_pieces(&pieces);
-        runs.push(FittedRun { pts, pieces });
+        stats.add_pieces(pieces);
+        if keep_runs {
+            runs.push(FittedRun { pts: pts.clone(), pieces: pieces.to_vec() });
+        }
         k = end + 1;
     }
     stats.output_moves = written;

@@ -149,13 +149,13 @@ fn options(args: &Args) -> Result<Options> {
 fn run(args: Args) -> Result<()> {
     let opts = options(&args)?;
     let started = Instant::now();
-    let input = Input::open(&args.io.input)?;
+    let mut input = Input::open(&args.io.input)?;
     let from = args.from.resolve(&input);
     let to = if args.to == Kind::Auto { from } else { args.to };
     let bytes_in = input.data.len();
     let mut out = Output::new(args.io.output.as_deref());
     let (stats, runs) = if from == Kind::Gcode {
-        let source = input.text()?.to_string();
+        let source = input.take_text()?;
         if source.trim().is_empty() {
             return Err(Error::input("empty input: no G-code").at(Location::file(&input.name)));
         }
@@ -166,8 +166,9 @@ fn run(args: Args) -> Result<()> {
                 format.decimals = d;
                 format.centre_decimals = d + 1;
             }
-            let (text, stats, runs) = gcode_runs::fit_program(&program, &opts, format)
-                .map_err(|e| unfittable(&input.name, u64::from(e.line), e.cause.deviation, &opts))?;
+            let (text, stats, runs) =
+                gcode_runs::fit_program(&program, &opts, format, args.svg.is_some() || args.lower_bound)
+                    .map_err(|e| unfittable(&input.name, u64::from(e.line), e.cause.deviation, &opts))?;
             out.buf = text;
             (stats, runs)
         } else {

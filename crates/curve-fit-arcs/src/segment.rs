@@ -16,16 +16,41 @@ pub struct Unfittable {
 
 /// Cuts `pts` (one run, no repeated points) into pieces that each stay within `opts.tol`.
 pub fn segment(pts: &[P3], opts: &Options, rounding: &dyn Rounding) -> Result<Vec<Piece>, Unfittable> {
+    let mut scratch = Scratch::default();
+    segment_with(pts, opts, rounding, &mut scratch)?;
+    Ok(scratch.pieces)
+}
+
+/// Buffers of a segmentation, kept between runs: a program of many short runs otherwise spends
+/// a tenth of its time allocating and freeing them.
+#[derive(Debug, Default)]
+pub struct Scratch {
+    corners: Vec<bool>,
+    written: Vec<P3>,
+    next_stop: Vec<usize>,
+    pieces: Vec<Piece>,
+}
+
+/// [`segment`] into `scratch`'s buffers; the pieces are borrowed from it until the next call.
+pub fn segment_with<'s>(
+    pts: &[P3],
+    opts: &Options,
+    rounding: &dyn Rounding,
+    scratch: &'s mut Scratch,
+) -> Result<&'s [Piece], Unfittable> {
+    scratch.pieces.clear();
     if pts.len() < 2 {
-        return Ok(Vec::new());
+        return Ok(&scratch.pieces);
     }
-    let corners = corners(pts, opts.corner, opts.tol);
-    let written: Vec<P3> = pts.iter().map(|p| rounding.point(p)).collect();
-    let run = Run { pts, written: &written, corners: &corners };
+    corners(pts, opts.corner, opts.tol, &mut scratch.corners);
+    scratch.written.clear();
+    scratch.written.extend(pts.iter().map(|p| rounding.point(p)));
+    let run = Run { pts, written: &scratch.written, corners: &scratch.corners };
     match opts.method {
-        Method::Fewest => fewest(&run, opts, rounding),
-        Method::Paper => paper(&run, opts, rounding),
+        Method::Fewest => fewest(&run, opts, rounding, &mut scratch.next_stop, &mut scratch.pieces)?,
+        Method::Paper => paper(&run, opts, rounding, &mut scratch.pieces)?,
     }
+    Ok(&scratch.pieces)
 }
 
 /// A run's points, as given and as written, and where it turns a corner.
@@ -38,9 +63,10 @@ struct Run<'a> {
 /// `true` at the interior points where the path turns by more than `limit` radians between
 /// two chords longer than `tol`: a corner seen at the tolerance's scale. (A jog of a few microns
 /// in a noisy program turns sharply too, but it is noise a fit may smooth within `tol`.)
-fn corners(pts: &[P3], limit: f64, tol: f64) -> Vec<bool> {
+fn corners(pts: &[P3], limit: f64, tol: f64, out: &mut Vec<bool>) {
     let cos_limit = limit.cos();
-    let mut out = vec![false; pts.len()];
+    out.clear();
+    out.resize(pts.len(), false);
     for k in 1..pts.len() - 1 {
         let a = pts[k] - pts[k - 1];
         let b = pts[k + 1] - pts[k];
@@ -48,7 +74,6 @@ fn corners(pts: &[P3], limit: f64, tol: f64) -> Vec<bool> {
         // The turn exceeds `limit` when cos(turn) = a·b / (|a| |b|) is below cos(limit).
         out[k] = la > tol && lb > tol && a.dot(&b) < cos_limit * la * lb;
     }
-    out
 }
 
 /// The tangent the piece after `prev` must follow.
@@ -86,16 +111,23 @@ fn single(run: &Run, first: usize, start: P3, opts: &Options) -> Result<Piece, U
 /// runs below it. Then a short look past the end, measured exactly with minimax centres too
 /// (validity is not always monotone in the end index). When validity is monotone (any piece
 /// inside a valid one is valid), greedy longest-first is optimal for the number of pieces.
-fn fewest(run: &Run, opts: &Options, rounding: &dyn Rounding) -> Result<Vec<Piece>, Unfittable> {
+/// `next_stop` is a buffer; the pieces are appended to `pieces`.
+fn fewest(
+    run: &Run,
+    opts: &Options,
+    rounding: &dyn Rounding,
+    next_stop: &mut Vec<usize>,
+    pieces: &mut Vec<Piece>,
+) -> Result<(), Unfittable> {
     const LOOK_PAST: usize = 3;
     let (pts, written, corners) = (run.pts, run.written, run.corners);
     let n = pts.len();
     // A piece never spans a corner: the first corner (or the end) after each point.
-    let mut next_stop = vec![n - 1; n];
+    next_stop.clear();
+    next_stop.resize(n, n - 1);
     for k in (1..n - 1).rev() {
         next_stop[k - 1] = if corners[k] { k } else { next_stop[k] };
     }
-    let mut pieces: Vec<Piece> = Vec::new();
     let mut first = 0;
     while first < n - 1 {
         let limit = next_stop[first];
@@ -138,7 +170,7 @@ fn fewest(run: &Run, opts: &Options, rounding: &dyn Rounding) -> Result<Vec<Piec
         first = good.last;
         pieces.push(good);
     }
-    Ok(pieces)
+    Ok(())
 }
 
 /// The largest `j` in `lo..=limit` for which `fits(j)` holds, assuming it holds at `lo` and is
@@ -177,8 +209,9 @@ fn farthest(lo: usize, limit: usize, guess: Option<usize>, fits: impl Fn(usize) 
 
 /// Paper 004 §2: the curvature of each point from the circle through it and its neighbours;
 /// consecutive points at or over the threshold are grouped and approximated by arcs, those under
-/// it by lines; a group is split where a point strays beyond the tolerance.
-fn paper(run: &Run, opts: &Options, rounding: &dyn Rounding) -> Result<Vec<Piece>, Unfittable> {
+/// it by lines; a group is split where a point strays beyond the tolerance. The pieces are
+/// appended to `pieces`.
+fn paper(run: &Run, opts: &Options, rounding: &dyn Rounding, pieces: &mut Vec<Piece>) -> Result<(), Unfittable> {
     let (pts, written, corners) = (run.pts, run.written, run.corners);
     let n = pts.len();
     let plane = opts.planes[0];
@@ -191,7 +224,6 @@ fn paper(run: &Run, opts: &Options, rounding: &dyn Rounding) -> Result<Vec<Piece
         curved[0] = curved[1];
         curved[n - 1] = curved[n - 2];
     }
-    let mut pieces: Vec<Piece> = Vec::new();
     let mut first = 0;
     while first < n - 1 {
         // The group: points of the same class as `first`, up to a corner.
@@ -219,5 +251,5 @@ fn paper(run: &Run, opts: &Options, rounding: &dyn Rounding) -> Result<Vec<Piece
         first = good.last;
         pieces.push(good);
     }
-    Ok(pieces)
+    Ok(())
 }
