@@ -2,7 +2,7 @@
 //! fitted per second on a dense smooth curve. Timing lives here, never in tests.
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
-use curve_fit_arcs::gcode_runs::{Format, fit_program};
+use curve_fit_arcs::gcode_runs::fit_source;
 use curve_fit_arcs::{Options, fit::Exact, segment};
 use std::hint::black_box;
 
@@ -14,11 +14,7 @@ fn gcode(c: &mut Criterion) {
     for tol in [0.025, 0.005] {
         let opts = Options { tol, ..Options::default() };
         group.bench_function(format!("jsdc tol {tol}"), |b| {
-            b.iter(|| {
-                let program = camkit::gcode::read("jsdc", source.clone()).expect("parses");
-                let format = Format::of(&program);
-                black_box(fit_program(&program, &opts, format, false).expect("fits"))
-            })
+            b.iter(|| black_box(fit_source("jsdc", &source, &opts, None, false).expect("fits")))
         });
     }
     group.bench_function("jsdc read only", |b| {

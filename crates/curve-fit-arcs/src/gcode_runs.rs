@@ -4,9 +4,10 @@
 use crate::fit::{Rounding, Shape};
 use crate::segment::{self, Unfittable};
 use crate::{FittedRun, Options, Stats, push_distinct};
-use camkit::gcode::{Block, Modes, Motion, MoveBlock, OutMove, Program, Units, Writer};
+use camkit::gcode::{Block, Blocks, Modes, Motion, MoveBlock, OutMove, Writer};
 use camkit::geom::{P2, P3};
 use camkit::num::round_to;
+use std::collections::VecDeque;
 
 /// How the program is written back.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -20,13 +21,30 @@ pub struct Format {
 }
 
 impl Format {
-    /// The program's own precision: the most decimals its coordinates and E words use, at least
-    /// 3 (4 for an inch program) for coordinates; arc centres one more.
-    pub fn of(program: &Program) -> Format {
-        let inch = program.blocks.iter().any(|b| b.modes().units == Units::Inch);
-        let decimals = program.decimals.xyz.max(if inch { 4 } else { 3 });
-        Format { decimals, centre_decimals: decimals + 1, e_decimals: program.decimals.e.max(1) }
+    /// A program's own precision from the blocks read: the most decimals its coordinates and E
+    /// words use, at least 3 (4 for an inch program) for coordinates; arc centres one more.
+    pub fn of(blocks: &Blocks) -> Format {
+        let (seen, inch) = (blocks.decimals(), blocks.inch());
+        let decimals = seen.xyz.max(if inch { 4 } else { 3 });
+        Format { decimals, centre_decimals: decimals + 1, e_decimals: seen.e.max(1) }
     }
+
+    /// With coordinates written to `decimals` places instead (centres one more), if given.
+    pub fn with_decimals(self, decimals: Option<u32>) -> Format {
+        match decimals {
+            Some(d) => Format { decimals: d, centre_decimals: d + 1, ..self },
+            None => self,
+        }
+    }
+}
+
+/// Why a program could not be fitted: its text, or a run.
+#[derive(Debug)]
+pub enum ProgramError {
+    /// The text is not a program the reader accepts.
+    Read(camkit::error::Error),
+    /// A run could not be fitted.
+    Fit(GcodeError),
 }
 
 /// Rounding as the writer does it, in a run's modes.
@@ -80,53 +98,103 @@ fn continues(head: &MoveBlock, m: &MoveBlock, opts: &Options) -> bool {
     }
 }
 
-/// Fits every run of `program` and writes the result; the fitted runs are returned too when
-/// `keep_runs` (for a plot or the lower bound), otherwise their buffers are reused run to run.
-pub fn fit_program(
-    program: &Program,
+/// Lines read to guess the output's precision before the streaming pass.
+const GUESS_LINES: usize = 2048;
+
+/// Reads and fits `source` in one streaming pass, holding one run at a time, never the whole
+/// program. The output's precision depends on the whole program (its most decimals), so it is
+/// guessed from the first lines and checked at the end; a wrong guess, or a run that failed
+/// under it, is done again with the precision read from the whole program. `decimals`
+/// overrides the coordinates'. The fitted runs are returned too when `keep_runs` (for a plot
+/// or the lower bound), otherwise their buffers are reused run to run.
+pub fn fit_source(
+    name: &str,
+    source: &str,
+    opts: &Options,
+    decimals: Option<u32>,
+    keep_runs: bool,
+) -> Result<(Vec<u8>, Stats, Vec<FittedRun>), ProgramError> {
+    let mut first = Blocks::new(name, source);
+    for b in first.by_ref().take(GUESS_LINES) {
+        b.map_err(ProgramError::Read)?;
+    }
+    let guess = Format::of(&first).with_decimals(decimals);
+    let mut lines = Blocks::new(name, source);
+    match fit_blocks(source, &mut lines, opts, guess, keep_runs) {
+        Ok(fitted) if Format::of(&lines).with_decimals(decimals) == guess => return Ok(fitted),
+        Err(ProgramError::Read(e)) => return Err(ProgramError::Read(e)),
+        Ok(_) | Err(ProgramError::Fit(_)) => {}
+    }
+    let mut all = Blocks::new(name, source);
+    for b in all.by_ref() {
+        b.map_err(ProgramError::Read)?;
+    }
+    let format = Format::of(&all).with_decimals(decimals);
+    fit_blocks(source, &mut Blocks::new(name, source), opts, format, keep_runs)
+}
+
+/// Fits every run of the blocks `lines` reads from `source` (their spans index it) under
+/// `format` and writes the result.
+fn fit_blocks(
+    source: &str,
+    lines: &mut Blocks,
     opts: &Options,
     format: Format,
     keep_runs: bool,
-) -> Result<(Vec<u8>, Stats, Vec<FittedRun>), GcodeError> {
+) -> Result<(Vec<u8>, Stats, Vec<FittedRun>), ProgramError> {
     let mut w = Writer::new(format.decimals, format.centre_decimals, format.e_decimals);
-    w.out.reserve(program.source.len());
-    let blocks = &program.blocks;
-    let moves: Vec<Option<&MoveBlock>> =
-        blocks.iter().map(|b| if let Block::Move(m) = b { Some(m) } else { None }).collect();
-    let mut stats = Stats { input_moves: moves.iter().flatten().count(), ..Stats::default() };
+    w.out.reserve(source.len());
+    let mut stats = Stats::default();
+    let mut input_moves = 0;
+    let mut read = || -> Result<Option<Block>, ProgramError> {
+        let block = lines.next().transpose().map_err(ProgramError::Read)?;
+        input_moves += usize::from(matches!(block, Some(Block::Move(_))));
+        Ok(block)
+    };
     let mut runs = Vec::new();
-    // Points of a run and the block index of each (buffers for all runs).
+    // A run's blocks from its head (moves and the comment lines among them), blocks read past a
+    // run's end to be looked at again, the run's points and the window index of each.
+    let mut window: Vec<Block> = Vec::new();
+    let mut pending: VecDeque<Block> = VecDeque::new();
     let mut pts: Vec<P3> = Vec::new();
     let mut from: Vec<usize> = Vec::new();
     let mut scratch = segment::Scratch::default();
     let mut written = 0;
-    let mut k = 0;
-    while k < blocks.len() {
-        let Some(head) = moves[k].filter(|m| can_start(m)) else {
-            w.verbatim(program.text(&blocks[k]), &blocks[k]);
-            written += usize::from(moves[k].is_some());
-            k += 1;
-            continue;
+    while let Some(block) = pending.pop_front().map_or_else(&mut read, |b| Ok(Some(b)))? {
+        let head = match &block {
+            Block::Move(m) if can_start(m) => m.clone(),
+            _ => {
+                w.verbatim(&source[block.span()], &block);
+                written += usize::from(matches!(block, Block::Move(_)));
+                continue;
+            }
         };
         // The run: moves that continue it, with comment-only lines between them carried along.
-        let mut end = k;
-        let mut probe = k + 1;
-        while probe < blocks.len() {
-            match &blocks[probe] {
-                Block::Other(o) if o.remark_only => probe += 1,
-                Block::Move(m) if continues(head, m, opts) => {
-                    end = probe;
-                    probe += 1;
+        window.clear();
+        window.push(block);
+        let mut end = 0;
+        while let Some(next) = pending.pop_front().map_or_else(&mut read, |b| Ok(Some(b)))? {
+            match &next {
+                Block::Other(o) if o.remark_only => {}
+                Block::Move(m) if continues(&head, m, opts) => end = window.len(),
+                _ => {
+                    pending.push_front(next);
+                    break;
                 }
-                _ => break,
             }
+            window.push(next);
         }
+        // Comment lines after the run's last move are read again after it, in order.
+        for b in window.drain(end + 1..).rev() {
+            pending.push_front(b);
+        }
+        let run = &window[..];
         pts.clear();
         from.clear();
         pts.push(head.start);
-        from.push(k);
-        for (i, m) in moves.iter().enumerate().take(end + 1).skip(k) {
-            let Some(m) = m else { continue };
+        from.push(0);
+        for (i, b) in run.iter().enumerate() {
+            let Block::Move(m) = b else { continue };
             if push_distinct(&mut pts, m.end) {
                 from.push(i);
             } else {
@@ -135,33 +203,30 @@ pub fn fit_program(
         }
         if pts.len() < 2 {
             // Only repeated points: nothing moves, nothing is written.
-            k = end + 1;
             continue;
         }
         let rounding = Written { writer: &w, modes: &head.modes };
         let pieces = segment::segment_with(&pts, opts, &rounding, &mut scratch)
-            .map_err(|cause| GcodeError { line: line_of(program, from[cause.at + 1]), cause })?;
+            .map_err(|cause| ProgramError::Fit(GcodeError { line: line_of(&run[from[cause.at + 1]]), cause }))?;
         for p in pieces {
             // Blocks covered by the piece: from[p.first + 1] ..= from[p.last] (plus dropped repeats).
-            let lo = if p.first == 0 { k } else { from[p.first] + 1 };
+            let lo = if p.first == 0 { 0 } else { from[p.first] + 1 };
             let hi = from[p.last];
-            let single = (lo..=hi).filter(|&i| moves[i].is_some()).count() == 1
-                && p.shape == Shape::Line
-                && p.end == pts[p.last]
-                && p.start == pts[p.first];
+            let covered = || run[lo..=hi].iter().filter_map(as_move);
+            let single =
+                covered().count() == 1 && p.shape == Shape::Line && p.end == pts[p.last] && p.start == pts[p.first];
             written += 1;
             if single {
-                for b in &blocks[lo..=hi] {
-                    w.verbatim(program.text(b), b);
+                for b in &run[lo..=hi] {
+                    w.verbatim(&source[b.span()], b);
                 }
                 continue;
             }
-            let covered = || (lo..=hi).filter_map(|i| moves[i]);
             let e = head.e.map(|_| {
                 if head.modes.e_relative {
                     round_to(covered().filter_map(|m| m.e).sum(), format.e_decimals)
                 } else {
-                    moves[hi].and_then(|m| m.e).unwrap_or(0.0)
+                    as_move(&run[hi]).and_then(|m| m.e).unwrap_or(0.0)
                 }
             });
             let (motion, centre, plane) = match p.shape {
@@ -176,37 +241,99 @@ pub fn fit_program(
                 plane,
                 feed: covered().find(|m| m.has_f).and(head.modes.feed),
                 e,
-                n: moves[hi].and_then(|m| m.n),
+                n: as_move(&run[hi]).and_then(|m| m.n),
             };
             w.motion(&out, &head.modes);
             // Comment lines among the piece's blocks follow it, in order.
-            remarks(&mut w, program, lo, hi);
+            remarks(&mut w, source, &run[lo..=hi]);
         }
         stats.points += pts.len();
         stats.add_pieces(pieces);
         if keep_runs {
             runs.push(FittedRun { pts: pts.clone(), pieces: pieces.to_vec() });
         }
-        k = end + 1;
     }
+    stats.input_moves = input_moves;
     stats.output_moves = written;
     Ok((w.out, stats, runs))
 }
 
-/// Copies the comment-only blocks among `from..=to`.
-fn remarks(w: &mut Writer, program: &Program, from: usize, to: usize) {
-    for b in &program.blocks[from..=to] {
+/// The motion block, if `b` is one.
+fn as_move(b: &Block) -> Option<&MoveBlock> {
+    if let Block::Move(m) = b { Some(m) } else { None }
+}
+
+/// Copies the comment-only blocks among `blocks`.
+fn remarks(w: &mut Writer, source: &str, blocks: &[Block]) {
+    for b in blocks {
         if let Block::Other(o) = b
             && o.remark_only
         {
-            w.verbatim(program.text(b), b);
+            w.verbatim(&source[b.span()], b);
         }
     }
 }
 
-fn line_of(program: &Program, block: usize) -> u32 {
-    match &program.blocks[block] {
+fn line_of(block: &Block) -> u32 {
+    match block {
         Block::Move(m) => m.line,
         Block::Other(o) => o.line,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `lines` moves along a zigzag with 3 decimals, then `tail`.
+    fn program(lines: usize, tail: &str) -> String {
+        let mut text = String::from("G21 G90\nG0 X0 Y0 Z0\nG1 F600\n");
+        for k in 1..=lines {
+            text += &format!("G1 X{}.125 Y{}\n", k, (k % 2) * 3);
+        }
+        text + tail
+    }
+
+    fn fit(text: &str, opts: &Options, decimals: Option<u32>) -> (String, Stats) {
+        let Ok((out, stats, _)) = fit_source("t.nc", text, opts, decimals, false) else { panic!("fit failed") };
+        (String::from_utf8(out).unwrap(), stats)
+    }
+
+    #[test]
+    fn precision_seen_only_after_the_guess_is_used_for_the_whole_program() {
+        let text = program(GUESS_LINES + 100, "G1 X9000.12345 Y1\nG1 X9001.5 Y2\n");
+        let opts = Options::default();
+        let (out, stats) = fit(&text, &opts, None);
+        // The whole program's precision (5 decimals), as with the decimals given up front.
+        assert_eq!(out, fit(&text, &opts, Some(5)).0);
+        assert!(out.contains("X9000.12345"), "{}", &out[out.len() - 80..]);
+        assert_eq!(stats.input_moves, GUESS_LINES + 103);
+        // A short program is guessed whole: the same precision.
+        let short = program(10, "G1 X20.12345 Y1\n");
+        assert_eq!(fit(&short, &opts, None).0, fit(&short, &opts, Some(5)).0);
+    }
+
+    #[test]
+    fn a_run_that_fails_only_under_the_guessed_precision_is_fitted_again() {
+        // Rounded to the first lines' 3 decimals, 0.00037 mm moves the end farther than --tol.
+        let text = program(GUESS_LINES + 10, "G1 X9000.00037 Y0\nG1 X9000.10037 Y0.5\nG1 X9000.20037 Y1\n");
+        let opts = Options { tol: 0.0002, ..Options::default() };
+        let (out, stats) = fit(&text, &opts, None);
+        assert!(out.contains("X9000.00037"), "{}", &out[out.len() - 120..]);
+        assert!(stats.largest_deviation <= opts.tol);
+        let err = fit_source("t.nc", &text, &opts, Some(3), false).err();
+        assert!(
+            matches!(err, Some(ProgramError::Fit(GcodeError { line, .. })) if line as usize == GUESS_LINES + 14),
+            "{err:?}"
+        );
+    }
+
+    #[test]
+    fn a_bad_word_anywhere_is_the_reader_s_error() {
+        let text = program(GUESS_LINES + 10, "G1 X1 Q\n");
+        let Some(ProgramError::Read(e)) = fit_source("t.nc", &text, &Options::default(), None, false).err() else {
+            panic!("a read error expected")
+        };
+        assert!(e.to_string().contains(&format!("t.nc:{}", GUESS_LINES + 14)), "{e}");
     }
 }

@@ -7,7 +7,7 @@ use camkit::io::{Input, Output, write_atomic};
 use camkit::report::Report;
 use camkit::table::{self, Col, WriteOptions};
 use clap::{Parser, ValueEnum};
-use curve_fit_arcs::gcode_runs::{self, Format};
+use curve_fit_arcs::gcode_runs::{self, ProgramError};
 use curve_fit_arcs::{Method, Options, Stats, Sweep, plot, table_runs};
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -159,19 +159,17 @@ fn run(args: Args) -> Result<()> {
         if source.trim().is_empty() {
             return Err(Error::input("empty input: no G-code").at(Location::file(&input.name)));
         }
-        let program = camkit::gcode::read(&input.name, source)?;
         if to == Kind::Gcode {
-            let mut format = Format::of(&program);
-            if let Some(d) = args.decimals {
-                format.decimals = d;
-                format.centre_decimals = d + 1;
-            }
-            let (text, stats, runs) =
-                gcode_runs::fit_program(&program, &opts, format, args.svg.is_some() || args.lower_bound)
-                    .map_err(|e| unfittable(&input.name, u64::from(e.line), e.cause.deviation, &opts))?;
+            let keep_runs = args.svg.is_some() || args.lower_bound;
+            let (text, stats, runs) = gcode_runs::fit_source(&input.name, &source, &opts, args.decimals, keep_runs)
+                .map_err(|e| match e {
+                    ProgramError::Read(e) => e,
+                    ProgramError::Fit(e) => unfittable(&input.name, u64::from(e.line), e.cause.deviation, &opts),
+                })?;
             out.buf = text;
             (stats, runs)
         } else {
+            let program = camkit::gcode::read(&input.name, source)?;
             let (t, skipped) = camkit::gcode::program_to_table(&program);
             if skipped > 0 {
                 cli::warn(&format!(

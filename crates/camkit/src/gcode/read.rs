@@ -102,34 +102,85 @@ fn m_led(line: &[u8]) -> Option<u32> {
 
 /// Reads a whole program. `name` is used in error messages.
 pub fn read(name: &str, source: String) -> Result<Program> {
-    let mut reader = Reader {
-        name,
-        modes: Modes::default(),
-        pos: [0.0; 3],
-        known: [false; 3],
-        virtual_frame: false,
-        e_mode_relative: false,
-        e_abs: None,
-    };
+    let mut lines = Blocks::new(name, &source);
     let mut blocks = Vec::with_capacity(source.len() / 24 + 1);
-    let mut decimals = Decimals::default();
-    let mut words: Vec<Word> = Vec::with_capacity(16);
-    let bytes = source.as_bytes();
-    let mut line_start = 0usize;
-    let mut line_no = 0u32;
-    while line_start < bytes.len() {
-        line_no += 1;
-        let nl = memchr::memchr(b'\n', &bytes[line_start..]).map_or(bytes.len(), |k| line_start + k);
-        let mut line_end = nl;
-        if line_end > line_start && bytes[line_end - 1] == b'\r' {
-            line_end -= 1;
-        }
-        let span = line_start..line_end;
-        let block = reader.block(&bytes[span.clone()], span, line_no, &mut words, &mut decimals)?;
-        blocks.push(block);
-        line_start = nl + 1;
+    for block in lines.by_ref() {
+        blocks.push(block?);
     }
+    let decimals = lines.decimals();
     Ok(Program { source, blocks, decimals })
+}
+
+/// The blocks of a program text, one per line, read as they are asked for: a filter that
+/// streams need not hold them all (a block is 176 bytes; a 2 MB printer file has 90 000).
+/// The first error ends the sequence.
+pub struct Blocks<'a> {
+    reader: Reader<'a>,
+    bytes: &'a [u8],
+    line_start: usize,
+    line_no: u32,
+    words: Vec<Word>,
+    decimals: Decimals,
+    inch: bool,
+    failed: bool,
+}
+
+impl<'a> Blocks<'a> {
+    /// Blocks of `source`; `name` is used in error messages.
+    pub fn new(name: &'a str, source: &'a str) -> Blocks<'a> {
+        Blocks {
+            reader: Reader {
+                name,
+                modes: Modes::default(),
+                pos: [0.0; 3],
+                known: [false; 3],
+                virtual_frame: false,
+                e_mode_relative: false,
+                e_abs: None,
+            },
+            bytes: source.as_bytes(),
+            line_start: 0,
+            line_no: 0,
+            words: Vec::with_capacity(16),
+            decimals: Decimals::default(),
+            inch: false,
+            failed: false,
+        }
+    }
+
+    /// Most decimals seen in the blocks read so far.
+    pub fn decimals(&self) -> Decimals {
+        self.decimals
+    }
+
+    /// True if any block read so far is in inch (G20).
+    pub fn inch(&self) -> bool {
+        self.inch
+    }
+}
+
+impl Iterator for Blocks<'_> {
+    type Item = Result<Block>;
+
+    fn next(&mut self) -> Option<Result<Block>> {
+        let bytes = self.bytes;
+        if self.failed || self.line_start >= bytes.len() {
+            return None;
+        }
+        self.line_no += 1;
+        let start = self.line_start;
+        let nl = memchr::memchr(b'\n', &bytes[start..]).map_or(bytes.len(), |k| start + k);
+        let mut end = nl;
+        if end > start && bytes[end - 1] == b'\r' {
+            end -= 1;
+        }
+        self.line_start = nl + 1;
+        let block =
+            self.reader.block(&bytes[start..end], start..end, self.line_no, &mut self.words, &mut self.decimals);
+        self.failed = block.is_err();
+        self.inch |= self.reader.modes.units == Units::Inch;
+        Some(block)
+    }
 }
 
 struct Reader<'a> {
