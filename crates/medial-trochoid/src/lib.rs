@@ -175,9 +175,26 @@ impl std::fmt::Display for PlanError {
 /// Simulates `program` for a tool of radius `r` and times it: feed moves of each kind run at
 /// the feed their worst engagement allows (entries at the slot feed).
 pub fn analyse(program: Program, s: &Settings, regions: &[Region]) -> Analysed {
+    analyse_after(program, s, regions, &Analysed::default(), 0)
+}
+
+/// [`analyse`] of a program whose first `unchanged` moves are those of `previous.program`:
+/// the engagement at their samples is taken from `previous`, not simulated again.
+pub fn analyse_after(
+    program: Program,
+    s: &Settings,
+    regions: &[Region],
+    previous: &Analysed,
+    unchanged: usize,
+) -> Analysed {
     let cut = Cut::new(s.radius, program.moves.iter().map(|m| m.seg).collect());
     let samples = cut.samples(s.sample);
-    let engagement = cut.profile(&samples);
+    let same = previous.samples.iter().take_while(|(i, _)| *i < unchanged).count();
+    debug_assert!(
+        previous.program.moves[..unchanged.min(previous.program.moves.len())]
+            == program.moves[..unchanged.min(program.moves.len())]
+    );
+    let engagement = cut.profile_from(&samples, &previous.engagement[..same]);
     let mut worst: HashMap<Tag, f64> = HashMap::new();
     for (&(i, _), &e) in samples.iter().zip(&engagement) {
         let w = worst.entry(program.moves[i].tag).or_insert(0.0);
@@ -376,7 +393,8 @@ pub fn plan(regions: &[Region], s: &Settings) -> Result<Plan, PlanError> {
             break;
         };
         relinks.push(how);
-        trochoidal = analyse(p, s, regions);
+        // The moves before the link are the same: their engagement is reused.
+        trochoidal = analyse_after(p, s, regions, &trochoidal, i);
     }
     Ok(Plan {
         regions: regions.to_vec(),
