@@ -264,3 +264,44 @@ fn box_die_whole_program_holds_the_threshold_links_included() {
     w.run(BIN, &args, b"").ok();
     assert!(w.read("d.csv") == w.read("t.csv"), "DXF and table inputs give different programs");
 }
+
+#[test]
+fn many_sided_pocket_holds_the_threshold_without_gouge() {
+    // A 32-gon: 32 shallow turns on every pass, dangerous stretches on every spoke of its
+    // medial axis (the engagement simulation's locality and screening keep this to seconds).
+    let w = Work::new();
+    let src = data("medial-trochoid/polygon32.csv");
+    let args = [src.to_str().unwrap(), "--radius", "2.5", "--sample", "1", "--report", "r.json", "-o", "t.csv"];
+    w.run(BIN, &args, b"").ok();
+    let r = report(&w, "r.json");
+    let f = |k: &str| r[k].as_f64().unwrap_or_else(|| panic!("{k} in {r}"));
+    assert!(f("offset_only_largest_engagement_deg") > 40.0 + 1e-5);
+    assert!(f("largest_engagement_deg") <= 40.0 + 1e-5, "{r}");
+    assert_eq!(r["samples_over_threshold"], 0);
+    assert_eq!(r["link_samples_over_threshold"], 0);
+    assert_eq!(r["threshold_held"], true);
+    assert_eq!(r["no_gouge"], true);
+    assert!(f("smallest_wall_clearance_mm") >= 2.5 - 1e-6);
+    assert_eq!(r["corner_rests"], 32);
+    assert!(r["trochoid_runs"].as_u64().unwrap() >= 32, "a run on every spoke: {r}");
+    // The written rows agree with the report: no cutting row over the threshold (3 decimals).
+    let out = rows(&w.read("t.csv"));
+    let worst = out.iter().filter(|(t, ..)| t == "trochoid" || t == "contour").filter_map(|r| r.1).fold(0.0, f64::max);
+    assert!(worst <= 40.0005, "{worst}");
+    // Every row's tool centre is at least R from every side of the 32-gon (vertices to 1e-6).
+    let v: Vec<(f64, f64)> = (0..32)
+        .map(|k| {
+            let a = f64::from(k) * std::f64::consts::TAU / 32.0;
+            (15.0 + 8.0 * a.cos(), 15.0 + 8.0 * a.sin())
+        })
+        .collect();
+    for (_, _, x, y) in &out {
+        for k in 0..32 {
+            let (a, b) = (v[k], v[(k + 1) % 32]);
+            let (dx, dy) = (b.0 - a.0, b.1 - a.1);
+            let t = (((x - a.0) * dx + (y - a.1) * dy) / (dx * dx + dy * dy)).clamp(0.0, 1.0);
+            let d = (x - a.0 - t * dx).hypot(y - a.1 - t * dy);
+            assert!(d >= 2.5 - 1e-5, "({x}, {y}) {d} from side {k}");
+        }
+    }
+}
