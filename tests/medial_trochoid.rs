@@ -282,7 +282,9 @@ fn many_sided_pocket_holds_the_threshold_without_gouge() {
     assert_eq!(r["threshold_held"], true);
     assert_eq!(r["no_gouge"], true);
     assert!(f("smallest_wall_clearance_mm") >= 2.5 - 1e-6);
-    assert_eq!(r["corner_rests"], 32);
+    // Shallow turns that hold the threshold sharp are kept sharp: no rest for them.
+    assert!(r["corner_rests"].as_u64().unwrap() < 32, "{r}");
+    assert_eq!(r["corners_unfitted"], 0);
     assert!(r["trochoid_runs"].as_u64().unwrap() >= 32, "a run on every spoke: {r}");
     // The written rows agree with the report: no cutting row over the threshold (3 decimals).
     let out = rows(&w.read("t.csv"));

@@ -164,7 +164,8 @@ pub fn start_mid_line(c: &Contour) -> Contour {
 /// `arc_margin_deg` under it: the program samples the arc at other places), the pass
 /// being cut (from its start, with the corners before already rounded) after everything in
 /// `before`. Each entry is the radius and the largest engagement near the corner (degrees),
-/// `Err` when no candidate holds the limit (then the candidate with the lowest engagement).
+/// `Err` when no candidate holds the limit (then the candidate with the lowest engagement);
+/// radius 0 (the corner kept sharp) when the sharp corner already holds the limit.
 /// Samples every `step` mm along the last tool radius of the incoming line and the first two
 /// tool radii of the outgoing line, and every `step / 2.5` mm along the arc.
 pub fn fit_corners(
@@ -183,17 +184,46 @@ pub fn fit_corners(
     for (q, &v) in corners.iter().enumerate() {
         slot[v] = Some(q);
     }
-    for j in 0..corners.len() {
+    let fitted = |o: &Result<(f64, f64), (f64, f64)>| o.map_or_else(|e| e.0, |o| o.0);
+    for (j, &vertex) in corners.iter().enumerate() {
         let mut best = (0.0, f64::INFINITY);
         let mut found = None;
+        // Corners before this one kept sharp make no arc: this one's arc is the next made.
+        let arcs_before = out.iter().filter(|o| fitted(o) > 0.0).count();
+        // A shallow turn may hold the limit sharp: the sharp corner is simulated first (the same
+        // samples: the last tool radius in, the first two out), and kept if it holds.
+        let sharp = |v: usize| match slot[v] {
+            Some(q) if q < j => fitted(&out[q]),
+            _ => 0.0,
+        };
+        let (plain, _) = round_with(c, sharp);
+        let at = vertex + arcs_before;
+        if at >= 1 && at + 1 < plain.vertices.len() {
+            let pieces: Vec<Seg> = (0..=at).map(|q| plain.seg(q)).collect();
+            let mut max = 0.0f64;
+            for (pk, piece) in pieces.iter().enumerate().skip(at - 1) {
+                let len = piece.length();
+                let (lo, hi) =
+                    if pk + 1 == at { (((len - r) / len).max(0.0), 1.0) } else { (0.0, (2.0 * r / len).min(1.0)) };
+                let n = ((hi - lo) * len / step).ceil().max(1.0) as usize;
+                for q in 1..=n {
+                    let t = lo + (hi - lo) * q as f64 / n as f64;
+                    max = max.max(before.engagement_after(&pieces, pk, t).to_degrees());
+                }
+            }
+            if max <= limit_deg {
+                out.push(Ok((0.0, max)));
+                continue;
+            }
+        }
         for &rho in candidates {
             let radius = |v: usize| match slot[v] {
-                Some(q) if q < j => out[q].map_or_else(|e| e.0, |o| o.0),
+                Some(q) if q < j => fitted(&out[q]),
                 Some(q) if q == j => rho,
                 _ => 0.0,
             };
             let (rounded, made) = round_with(c, radius);
-            let Some(&Rounded { rho: used, arc: k, .. }) = made.get(j) else { break };
+            let Some(&Rounded { rho: used, arc: k, .. }) = made.get(arcs_before) else { break };
             let m = rounded.vertices.len();
             if k == 0 || k + 1 >= m {
                 break;

@@ -417,7 +417,8 @@ pub const CORNER_RADII: [f64; 18] =
     [0.25, 0.5, 0.75, 1.0, 1.25, 1.5, 1.75, 2.0, 2.25, 2.5, 2.75, 3.0, 3.5, 4.0, 5.0, 6.0, 7.0, 8.0];
 
 /// The passes with the wall passes' (level 0) sharp inside corners rounded, and the rest each
-/// rounded corner leaves. Each corner's radius is the given one, or the smallest of
+/// rounded corner leaves. Each corner's radius is the given one, or none (kept sharp) if the
+/// sharp corner holds the threshold in the simulation (shallow turns), or the smallest of
 /// [`CORNER_RADII`] whose simulated engagement (after the trochoids and every inner pass) stays
 /// at or under the threshold; where none does, the one with the lowest engagement (and the
 /// whole-program check reports it).
@@ -450,7 +451,8 @@ fn round_walls(passes: &[Pass], troch: &Program, s: &Settings) -> (Vec<Pass>, Ve
             };
             let at = |i: usize| corners.iter().position(|&c| c == i);
             let (contour, rounded) = corner::round_with(&start, |i| at(i).map_or(0.0, |k| fits[k].0));
-            rests.extend(rounded.into_iter().zip(&fits).map(|(k, f)| corner::Rest {
+            // Corners kept sharp (radius 0: they hold the threshold) make no arc and leave no rest.
+            rests.extend(rounded.into_iter().zip(fits.iter().filter(|f| f.0 > 0.0)).map(|(k, f)| corner::Rest {
                 corner: k.at - k.inward * (s.radius / (0.5 * k.turn).cos()),
                 inward: k.inward,
                 rho: k.rho,
