@@ -7,7 +7,7 @@
 #      times, bare results run through our check);
 #   2. pyclipper (PyPI, Clipper 1, integer polygons: arcs become chords) on the same vertices.
 #
-#   scripts/bench-offset.sh
+#   scripts/bench-offset.sh                  (SKIP_PYCLIPPER=1: the first part only)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 WORK=${WORK:-target/bench-offset}
@@ -17,6 +17,7 @@ echo "== load before: $(uptime)"
 echo "== cavalier_contours (bare) vs offset's verified kernel"
 cargo run -q --release -p offset --example offset_peers -- "$WORK"
 echo "== load after: $(uptime)"
+[ -n "${SKIP_PYCLIPPER:-}" ] && exit 0
 
 if [ ! -x "$WORK/venv/bin/python" ]; then
   python3 -m venv "$WORK/venv"

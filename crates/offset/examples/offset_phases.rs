@@ -5,7 +5,8 @@
 //!
 //! `RAYON_NUM_THREADS=1 valgrind --tool=callgrind target/release/examples/offset_phases N lines|arcs D [bare]`
 //! (`bare`: cavalier_contours alone with its default options; `none`: the star alone; `pocket`: a pocket to empty with
-//! radius D and step 2; `levels`: each region offset of such a pocket timed alone).
+//! radius D and step 2, timed; `pocket1`: that pocket once; `barepocket`: bare cavalier's shape offsets of the same
+//! levels once; `levels`: each region offset of such a pocket timed alone).
 
 use camkit::contour::offset::{Side, check_offset, offset_contour};
 use camkit::contour::{Contour, OffsetOptions, Vertex};
@@ -46,6 +47,37 @@ fn main() {
             p.add(v.p.x, v.p.y, v.bulge);
         }
         println!("{} pieces", p.parallel_offset_opt(d, &PlineOffsetOptions::default()).len());
+        return;
+    }
+    if args.get(4).is_some_and(|s| s == "barepocket") {
+        // Bare cavalier_contours' pocket to empty (default options, levels D + 2k until none is
+        // left), once: the peer of `pocket` for instruction counts.
+        use cavalier_contours::shape_algorithms::{Shape, ShapeOffsetOptions};
+        let mut p = Polyline::new_closed();
+        for v in &c.vertices {
+            p.add(v.p.x, v.p.y, v.bulge);
+        }
+        let shape = Shape::from_plines([p]);
+        let mut k = 0;
+        while !shape.parallel_offset(d.abs() + 2.0 * k as f64, &ShapeOffsetOptions::default()).ccw_plines.is_empty() {
+            k += 1;
+        }
+        println!("bare pocket: {k} levels");
+        return;
+    }
+    if args.get(4).is_some_and(|s| s == "pocket1") {
+        // Our pocket to empty once (radius D, step 2), for instruction counts.
+        use camkit::contour::pocket::{Direction, Passes, PocketOptions, pocket};
+        let (rs, _) = camkit::contour::region::regions(std::slice::from_ref(&c)).expect("a region");
+        let po = PocketOptions {
+            radius: d.abs(),
+            step: 2.0,
+            passes: Passes::UntilEmpty,
+            direction: Direction::Climb,
+            offset: opts,
+        };
+        let p = pocket(&rs, &po).expect("pocket");
+        println!("pocket: {} passes, {} kernel runs", p.passes.len(), p.attempts);
         return;
     }
     if args.get(4).is_some_and(|s| s == "pocket") {

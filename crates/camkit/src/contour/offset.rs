@@ -178,17 +178,33 @@ fn verified_from(
     inward: bool,
     kernel: impl Fn(&[&Contour], Eps, Option<&Index>) -> Vec<Contour>,
 ) -> Result<Offset, OffsetError> {
-    let set = SegSet::new(input.iter().copied());
+    verified_with_set(&SegSet::new(input.iter().copied()), source, input, d, side, closed, opts, inward, kernel)
+}
+
+/// [`verified_from`] with `input`'s pieces already in `set` (`SegSet::new(input)`), so that
+/// several offsets of one region (the levels of a pocket) share them.
+#[allow(clippy::too_many_arguments)]
+fn verified_with_set(
+    set: &SegSet,
+    source: &[&Contour],
+    input: &[&Contour],
+    d: f64,
+    side: f64,
+    closed: bool,
+    opts: &OffsetOptions,
+    inward: bool,
+    kernel: impl Fn(&[&Contour], Eps, Option<&Index>) -> Vec<Contour>,
+) -> Result<Offset, OffsetError> {
     if inward
         && set.covers(d - opts.tol - tol::ROUNDOFF_ABS, COVER_BUDGET)
-        && let Ok(check) = verify(&set, &[], d, side, closed, opts.tol, opts.self_crossing_input)
+        && let Ok(check) = verify(set, &[], d, side, closed, opts.tol, opts.self_crossing_input)
     {
         return Ok(Offset { contours: Vec::new(), check, attempts: 0, cleaned: false });
     }
     // One contour offset from itself: the verification's index of its pieces (exact boxes, in
     // the order of its vertices) serves the kernel too, and its pieces give the ladder.
     let alone = source.len() == 1 && input.len() == 1 && std::ptr::eq(source[0], input[0]);
-    let scale = if alone { ladder_of_one(&set) } else { None }.unwrap_or_else(|| ladder(source));
+    let scale = if alone { ladder_of_one(set) } else { None }.unwrap_or_else(|| ladder(source));
     let mut attempts = 0;
     let mut defect = None;
     for was_cleaned in [false, true] {
@@ -212,14 +228,20 @@ fn verified_from(
             };
             // A loop no longer than the tolerance is round-off where two loops touch (the lens
             // between two tangent circles): the tool would cut nothing there.
-            out.retain(|c| c.length() > opts.tol);
-            match verify(&set, &out, d, side, closed, opts.tol, opts.self_crossing_input) {
+            out.retain(|c| longer_than(c, opts.tol));
+            match verify(set, &out, d, side, closed, opts.tol, opts.self_crossing_input) {
                 Ok(check) => return Ok(Offset { contours: out, check, attempts, cleaned: was_cleaned }),
                 Err(e) => defect = Some(e),
             }
         }
     }
     Err(OffsetError { attempts, defect: defect.expect("at least one attempt") })
+}
+
+/// True if `c` is longer than `len` (mm): its length summed piece by piece stops once past it
+/// (the partial sums only grow, so this is `c.length() > len`).
+fn longer_than(c: &Contour, len: f64) -> bool {
+    c.segs().try_fold(0.0, |sum, s| Some(sum + s.length()).filter(|l| *l <= len)).is_none()
 }
 
 thread_local! {
@@ -274,6 +296,47 @@ pub fn offset_contour(c: &Contour, d: f64, side: Side, opts: &OffsetOptions) -> 
 pub fn offset_region(region: &Region, d: f64, opts: &OffsetOptions) -> Result<Offset, OffsetError> {
     let loops = region.loops();
     verified_from(&loops, &loops, d, 1.0, true, opts, true, |source, eps, _| shape_offset(source, d, eps))
+}
+
+/// The pieces of a region's loops, made once for several offsets of it ([`offset_region_in`],
+/// [`RegionPieces::first_empty_level`]).
+pub(crate) struct RegionPieces(SegSet);
+
+impl RegionPieces {
+    /// The pieces of `region`'s loops, in the order [`offset_region`] takes them.
+    pub(crate) fn new(region: &Region) -> RegionPieces {
+        RegionPieces(SegSet::new(region.loops()))
+    }
+
+    /// The first of `distances` (increasing) at which an inward offset of the region is shown
+    /// empty by the cheap proof that [`offset_region`] tries first ([`SegSet::covers`]), if any.
+    /// That offset and every deeper one are empty (each lies inside the one before it).
+    pub(crate) fn first_empty_level(&self, distances: &[f64], opts: &OffsetOptions) -> Option<usize> {
+        let empty = |k: usize| self.0.covers(distances[k] - opts.tol - tol::ROUNDOFF_ABS, COVER_BUDGET);
+        // The proof only gets easier with depth: bisect for the first level it holds at.
+        let (mut lo, mut hi) = (0, distances.len().checked_sub(1)?);
+        if !empty(hi) {
+            return None;
+        }
+        while lo < hi {
+            let mid = lo + (hi - lo) / 2;
+            if empty(mid) { hi = mid } else { lo = mid + 1 }
+        }
+        Some(hi)
+    }
+}
+
+/// [`offset_region`] with the region's pieces made beforehand (the same result).
+pub(crate) fn offset_region_in(
+    region: &Region,
+    pieces: &RegionPieces,
+    d: f64,
+    opts: &OffsetOptions,
+) -> Result<Offset, OffsetError> {
+    let loops = region.loops();
+    verified_with_set(&pieces.0, &loops, &loops, d, 1.0, true, opts, true, |source, eps, _| {
+        shape_offset(source, d, eps)
+    })
 }
 
 /// Offsets `loops` (a region already offset from `input`'s loops, oriented as a region) inward by

@@ -10,7 +10,9 @@
 //! than the tool radius inside it) gets one clean-up pass as deep as the piece allows.
 
 use super::Contour;
-use super::offset::{OffsetError, OffsetOptions, offset_region, offset_region_further, region_survives};
+use super::offset::{
+    OffsetError, OffsetOptions, RegionPieces, offset_region_further, offset_region_in, region_survives,
+};
 use super::region::Region;
 use super::verify::Check;
 use crate::geom::P2;
@@ -136,11 +138,21 @@ pub fn pocket(regions: &[Region], opts: &PocketOptions) -> Result<Pocket, Pocket
                 ((half - opts.radius) / opts.step).floor().max(0.0) as usize + 2
             }
         };
-        let distances: Vec<f64> = (0..levels).map(|k| opts.radius + k as f64 * opts.step).collect();
+        let mut distances: Vec<f64> = (0..levels).map(|k| opts.radius + k as f64 * opts.step).collect();
+        // The region's pieces serve every level; levels beyond the first one proved empty are
+        // not computed (the loop below stops at the first empty level anyway).
+        let input = RegionPieces::new(region);
+        if let Some(k) = input.first_empty_level(&distances, &opts.offset) {
+            distances.truncate(k + 1);
+        }
         let offsets: Vec<Result<super::Offset, PocketError>> = distances
             .par_iter()
             .map(|&d| {
-                offset_region(region, d, &opts.offset).map_err(|error| PocketError { region: ri, distance: d, error })
+                offset_region_in(region, &input, d, &opts.offset).map_err(|error| PocketError {
+                    region: ri,
+                    distance: d,
+                    error,
+                })
             })
             .collect();
         let mut pieces: Vec<Piece> = Vec::new();

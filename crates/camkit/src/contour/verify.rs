@@ -240,46 +240,38 @@ impl SegSet {
         // One search of the index per group of consecutive pieces (the union of their circles'
         // boxes); a piece that meets piece `i` has a box that meets `i`'s, so it is in the list.
         let n = self.segs.len();
-        (0..n)
-            .step_by(GROUP)
-            .collect::<Vec<usize>>()
-            .into_par_iter()
-            .map_init(
-                || (Vec::new(), Vec::new()),
-                |(stack, near), start| {
-                    let group = start..(start + GROUP).min(n);
-                    let boxes = group.clone().map(|i| {
-                        let (c, r) = self.circles[i];
-                        (P2::new(c.x - r, c.y - r), P2::new(c.x + r, c.y + r))
-                    });
-                    let (lo, hi) = boxes.reduce(|(lo, hi), (a, b)| {
-                        (P2::new(lo.x.min(a.x), lo.y.min(a.y)), P2::new(hi.x.max(b.x), hi.y.max(b.y)))
-                    })?;
-                    near.clear();
-                    self.visit(&lo, &hi, 0.0, stack, |j| {
-                        near.push(j);
-                        false
-                    });
-                    group.into_iter().find_map(|i| {
-                        let s = &self.segs[i];
-                        let (cs, rs) = self.circles[i];
-                        let first = near
-                            .iter()
-                            .copied()
-                            .filter(|&j| {
-                                j > i
-                                    && !self.adjacent(i, j)
-                                    && self.circle_within(j, &cs, rs, 0.0)
-                                    && s.min_distance(&self.segs[j]) == 0.0
-                                    && !(touch > 0.0 && self.touch_at_vertex(i, j, touch))
-                            })
-                            .min();
-                        first.map(|j| meeting_point(s, &self.segs[j]))
+        let groups: Vec<usize> = (0..n).step_by(GROUP).collect();
+        first_of(groups, n < SERIAL_BELOW, |(stack, near): &mut (Vec<usize>, Vec<usize>), start| {
+            let group = start..(start + GROUP).min(n);
+            let boxes = group.clone().map(|i| {
+                let (c, r) = self.circles[i];
+                (P2::new(c.x - r, c.y - r), P2::new(c.x + r, c.y + r))
+            });
+            let (lo, hi) = boxes.reduce(|(lo, hi), (a, b)| {
+                (P2::new(lo.x.min(a.x), lo.y.min(a.y)), P2::new(hi.x.max(b.x), hi.y.max(b.y)))
+            })?;
+            near.clear();
+            self.visit(&lo, &hi, 0.0, stack, |j| {
+                near.push(j);
+                false
+            });
+            group.into_iter().find_map(|i| {
+                let s = &self.segs[i];
+                let (cs, rs) = self.circles[i];
+                let first = near
+                    .iter()
+                    .copied()
+                    .filter(|&j| {
+                        j > i
+                            && !self.adjacent(i, j)
+                            && self.circle_within(j, &cs, rs, 0.0)
+                            && s.min_distance(&self.segs[j]) == 0.0
+                            && !(touch > 0.0 && self.touch_at_vertex(i, j, touch))
                     })
-                },
-            )
-            .find_first(|p| p.is_some())
-            .flatten()
+                    .min();
+                first.map(|j| meeting_point(s, &self.segs[j]))
+            })
+        })
     }
 
     /// True if pieces `i` and `j` have ends within `touch` of each other and, without the
@@ -644,6 +636,40 @@ impl FastArc {
     }
 }
 
+/// Pieces below which a check runs on the calling thread: handing a millisecond of work to the
+/// pool (waking its threads, waiting for the last) costs more than sharing it saves when the
+/// cores are busy. The results are the same either way.
+const SERIAL_BELOW: usize = 2048;
+
+/// `f(scratch, item)` for every item, in order; on the thread pool unless `serial`, with one
+/// scratch `S` per worker.
+fn map_of<S: Default, T: Send>(
+    items: Vec<usize>,
+    serial: bool,
+    f: impl Fn(&mut S, usize) -> T + Sync + Send,
+) -> Vec<T> {
+    if serial {
+        let mut scratch = S::default();
+        items.into_iter().map(|i| f(&mut scratch, i)).collect()
+    } else {
+        items.into_par_iter().map_init(S::default, f).collect()
+    }
+}
+
+/// The first `Some` of `f(scratch, item)` in the items' order, as [`map_of`].
+fn first_of<S: Default, T: Send>(
+    items: Vec<usize>,
+    serial: bool,
+    f: impl Fn(&mut S, usize) -> Option<T> + Sync + Send,
+) -> Option<T> {
+    if serial {
+        let mut scratch = S::default();
+        items.into_iter().find_map(|i| f(&mut scratch, i))
+    } else {
+        items.into_par_iter().map_init(S::default, f).find_first(Option::is_some).flatten()
+    }
+}
+
 /// What the checks of one block of output pieces found: the largest distance above `d`, the
 /// largest shortfall below it, and the generator of each piece.
 type Block = (f64, f64, Vec<usize>);
@@ -798,9 +824,8 @@ fn verify_with(
     }
     let out = SegSet::new(output);
     let starts: Vec<usize> = (0..out.segs.len()).step_by(BLOCK).collect();
-    let blocks: Vec<Result<Block, Defect>> = starts
-        .par_iter()
-        .map_init(Scratch::default, |scratch, &start| {
+    let blocks: Vec<Result<Block, Defect>> =
+        map_of(starts, out.segs.len() < SERIAL_BELOW, |scratch: &mut Scratch, start| {
             let (mut above, mut below, mut hint) = (0.0f64, 0.0f64, None);
             let mut generators = Vec::with_capacity(BLOCK);
             for i in start..(start + BLOCK).min(out.segs.len()) {
@@ -838,8 +863,7 @@ fn verify_with(
                 generators.push(g);
             }
             Ok((above, below, generators))
-        })
-        .collect();
+        });
     let mut check = Check { distance: d, pieces: out.segs.len(), ..Check::default() };
     // The first and last output piece each input piece generated: where the completeness probe
     // of that input piece looks before searching the output's index.
@@ -857,9 +881,8 @@ fn verify_with(
     }
     // Completeness: valid raw offset points of the input's pieces lie on the output (tested in
     // the cheaper order: a point on the output needs no validity test).
-    let missing: Option<P2> = (0..input.segs.len())
-        .into_par_iter()
-        .map_init(Scratch::default, |scratch, i| {
+    let missing: Option<P2> =
+        first_of((0..input.segs.len()).collect(), input.segs.len() < SERIAL_BELOW, |scratch: &mut Scratch, i| {
             let t = &input.segs[i];
             if t.length() <= tol {
                 return None;
@@ -876,9 +899,7 @@ fn verify_with(
             let invalid = hit.is_some();
             scratch.hit = hit.or(scratch.hit);
             (!invalid).then_some(c)
-        })
-        .find_first(|c| c.is_some())
-        .flatten();
+        });
     if let Some(c) = missing {
         return Err(Defect::Missing(c));
     }
@@ -1050,6 +1071,47 @@ mod tests {
                     prop_assert!(o.contours.is_empty(), "the kernel found {} loops", o.contours.len());
                 }
             }
+        }
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig { cases: 16, ..ProptestConfig::default() })]
+
+        /// A pocket computes no level beyond the first one its cheap proof shows empty, and that
+        /// changes no pass: the first such level is empty by the full offset too, and the pocket's
+        /// passes per level are those of the region's offsets made level by level up to the first
+        /// empty one.
+        #[test]
+        fn pocket_skips_only_empty_levels((radii, bulges) in star_parts(), radius in 0.5f64..3.0, step in 1.0f64..6.0) {
+            use crate::contour::offset::{RegionPieces, offset_region};
+            use crate::contour::pocket::{Direction, Passes, PocketOptions, pocket};
+            let c = star(&radii, &bulges);
+            let (rs, _) = crate::contour::region::regions(std::slice::from_ref(&c)).unwrap();
+            let opts = OffsetOptions::default();
+            let distances: Vec<f64> = (0..48).map(|k| radius + k as f64 * step).collect();
+            let mut levels: Vec<(usize, f64)> = Vec::new();
+            for &d in &distances {
+                let o = offset_region(&rs[0], d, &opts).unwrap_or_else(|e| panic!("{e}"));
+                if o.contours.is_empty() {
+                    break;
+                }
+                levels.push((o.contours.len(), o.contours.iter().map(Contour::area).sum()));
+            }
+            let first = RegionPieces::new(&rs[0]).first_empty_level(&distances, &opts);
+            if let Some(k) = first {
+                prop_assert!(k >= levels.len(), "level {k} proved empty, {} levels are not", levels.len());
+                prop_assert!(offset_region(&rs[0], distances[k], &opts).unwrap().contours.is_empty());
+            }
+            let po = PocketOptions { radius, step, passes: Passes::UntilEmpty, direction: Direction::Climb, offset: opts };
+            let p = pocket(&rs, &po).unwrap_or_else(|e| panic!("{e:?}"));
+            for (k, (count, area)) in levels.iter().enumerate() {
+                let at: Vec<&crate::contour::pocket::Pass> =
+                    p.passes.iter().filter(|q| !q.clean_up && q.level == k).collect();
+                prop_assert_eq!(at.len(), *count, "level {}", k);
+                let sum: f64 = at.iter().map(|q| q.contour.area()).sum();
+                prop_assert!((sum - area).abs() < 1e-9, "level {k}: area {sum} vs {area}");
+            }
+            prop_assert!(p.passes.iter().all(|q| q.clean_up || q.level < levels.len()));
         }
     }
 
