@@ -110,30 +110,41 @@ impl Cut {
     /// followed by `recent` (cut after them, in order).
     ///
     /// Only pieces whose box is nearer than 2R to `p` can touch the circle. They are taken in
-    /// two stages: first `recent` and the [`RECENT`] pieces before `before`, by index (the
-    /// latest cuts, which clear most of the circle); then, from the grid, the older pieces near
-    /// the arcs still in material. A piece whose box is R + [`SCREEN_MARGIN`] or more from the
-    /// boxes of those arcs (renewed every [`SCREEN_EVERY`] pieces taken) is skipped: it removes
+    /// two stages, latest first: `recent` and the [`RECENT`] pieces before `before`, by index
+    /// (the latest cuts, which clear most of the circle); then, from the grid, the older pieces
+    /// near the arcs still in material. In both, a piece whose box is R + [`SCREEN_MARGIN`] or
+    /// more from the boxes of those arcs (renewed every [`SCREEN_EVERY`] pieces taken) is skipped: it removes
     /// nothing from them, so every arc it would remove lies inside the union already taken and
     /// the merged union, hence the angle, is the same to the bit as with every piece taken.
     fn free(&self, p: &P2, before: usize, recent: &[Seg]) -> f64 {
         let r = self.radius;
         let touches = |b: &(P2, P2)| within_reach(b, p, 2.0 * r);
+        let reach = r + SCREEN_MARGIN;
         let mut all: Vec<(f64, f64)> = Vec::new();
-        for s in recent.iter().rev().filter(|s| touches(&s.bounds())) {
-            all.extend(removed_by(p, r, s).0);
-        }
+        let mut screen: Option<Vec<(P2, P2)>> = None;
+        let mut taken = 0;
         let old = before.saturating_sub(RECENT);
-        for j in (old..before).rev().filter(|&j| touches(&self.boxes[j])) {
-            all.extend(removed_by(p, r, &self.pieces[j]).0);
+        let latest = recent
+            .iter()
+            .rev()
+            .map(|s| (s, s.bounds()))
+            .chain((old..before).rev().map(|j| (&self.pieces[j], self.boxes[j])));
+        for (s, b) in latest {
+            if !touches(&b) || screen.as_ref().is_some_and(|q| !q.iter().any(|q| boxes_within(&b, q, reach))) {
+                continue;
+            }
+            all.extend(removed_by(p, r, s).0);
+            taken += 1;
+            if taken % SCREEN_EVERY == 0 {
+                merge(&mut all);
+                screen = Some(material_boxes(p, r, &all));
+            }
         }
         merge(&mut all);
-        let reach = r + SCREEN_MARGIN;
         let mut screen = material_boxes(p, r, &all);
         if let Some((lo, hi)) = hull(&screen) {
             let (qx0, qy0) = key(self.cell, &P2::new(lo.x - reach, lo.y - reach));
             let (qx1, qy1) = key(self.cell, &P2::new(hi.x + reach, hi.y + reach));
-            let mut taken = 0;
             'cells: for x in qx0..=qx1 {
                 for y in qy0..=qy1 {
                     let Some(list) = self.grid.get(&(x, y)) else { continue };
