@@ -114,13 +114,12 @@ pub fn fit_source(
     decimals: Option<u32>,
     keep_runs: bool,
 ) -> Result<(Vec<u8>, Stats, Vec<FittedRun>), ProgramError> {
-    let mut first = Blocks::new(name, source);
-    for b in first.by_ref().take(GUESS_LINES) {
-        b.map_err(ProgramError::Read)?;
-    }
-    let guess = Format::of(&first).with_decimals(decimals);
+    // The first lines are kept, not read again, and fitted first.
     let mut lines = Blocks::new(name, source);
-    match fit_blocks(source, &mut lines, opts, guess, keep_runs) {
+    let first: Vec<Block> =
+        lines.by_ref().take(GUESS_LINES).collect::<camkit::error::Result<_>>().map_err(ProgramError::Read)?;
+    let guess = Format::of(&lines).with_decimals(decimals);
+    match fit_blocks(source, &mut first.into_iter().map(Ok).chain(lines.by_ref()), opts, guess, keep_runs) {
         Ok(fitted) if Format::of(&lines).with_decimals(decimals) == guess => return Ok(fitted),
         Err(ProgramError::Read(e)) => return Err(ProgramError::Read(e)),
         Ok(_) | Err(ProgramError::Fit(_)) => {}
@@ -137,7 +136,7 @@ pub fn fit_source(
 /// `format` and writes the result.
 fn fit_blocks(
     source: &str,
-    lines: &mut Blocks,
+    lines: &mut impl Iterator<Item = camkit::error::Result<Block>>,
     opts: &Options,
     format: Format,
     keep_runs: bool,
