@@ -17,22 +17,53 @@ const SAME_POINT: f64 = 1e-9;
 
 /// Angles of the circle (centre `p`, radius `r`) closer than `r` to the disk-swept piece `s`.
 pub fn removed_by(p: &P2, r: f64, s: &Seg) -> AngleSet {
+    removed_shaped(p, r, s, &Shape::of(s))
+}
+
+/// The constants of a piece that [`removed_by`] needs at every sample: a line's direction and
+/// normal with their angles, an arc's wedge rays (computed once per piece, the same values).
+#[derive(Clone, Copy, Debug)]
+enum Shape {
+    /// A line of length `len` (over [`SAME_POINT`]) along `t`, normal `n`, at angles `at`, `an`.
+    Line { len: f64, t: V2, n: V2, at: f64, an: f64 },
+    /// A line no longer than [`SAME_POINT`]: its end disks only.
+    Point,
+    /// An arc's wedge from angle `a0` over `w`, its rays `d0`, `d1`.
+    Arc { a0: f64, w: f64, d0: V2, d1: V2 },
+}
+
+impl Shape {
+    fn of(s: &Seg) -> Shape {
+        match s {
+            Seg::Line(a, b) => {
+                let d = b - a;
+                let len = d.norm();
+                if len <= SAME_POINT {
+                    return Shape::Point;
+                }
+                let t = d / len;
+                let n = V2::new(-t.y, t.x);
+                Shape::Line { len, t, n, at: angle_of(&t), an: angle_of(&n) }
+            }
+            Seg::Arc(q) => {
+                let (a0, w) = (q.start.min(q.start + q.sweep), q.sweep.abs());
+                Shape::Arc { a0, w, d0: V2::new(a0.cos(), a0.sin()), d1: V2::new((a0 + w).cos(), (a0 + w).sin()) }
+            }
+        }
+    }
+}
+
+/// [`removed_by`] with the piece's [`Shape`] given.
+fn removed_shaped(p: &P2, r: f64, s: &Seg, shape: &Shape) -> AngleSet {
     let (a, b) = (s.start(), s.end());
     let mut out = disk(p, r, &a).union(&disk(p, r, &b));
-    let body = match s {
-        Seg::Line(..) => {
-            let d = b - a;
-            let len = d.norm();
-            if len <= SAME_POINT {
-                return out;
-            }
-            let t = d / len;
-            let n = V2::new(-t.y, t.x);
-            let (at, an) = (angle_of(&t), angle_of(&n));
+    let body = match (s, shape) {
+        (_, Shape::Point) => return out,
+        (Seg::Line(..), &Shape::Line { len, t, n, at, an }) => {
             let along = AngleSet::band((p - a).dot(&t), r, at, 0.0, len);
             along.intersect(&AngleSet::band((p - a).dot(&n), r, an, -r, r))
         }
-        Seg::Arc(q) => {
+        (Seg::Arc(q), &Shape::Arc { a0, w, d0, d1 }) => {
             let v = p - q.c;
             let dist = v.norm();
             let (lo, hi) = ((q.r - r).max(0.0), q.r + r);
@@ -42,8 +73,9 @@ pub fn removed_by(p: &P2, r: f64, s: &Seg) -> AngleSet {
                 // |q − c|² = D² + R² + 2RD cos(θ − α).
                 AngleSet::band(dist * dist + r * r, 2.0 * r * dist, angle_of(&v), lo * lo, hi * hi)
             };
-            ring.intersect(&wedge(p, r, q.c, q.start.min(q.start + q.sweep), q.sweep.abs()))
+            ring.intersect(&wedge(p, r, q.c, a0, w, d0, d1))
         }
+        _ => unreachable!("a shape is made from its own piece"),
     };
     out = out.union(&body);
     out
@@ -58,11 +90,10 @@ fn disk(p: &P2, r: f64, c: &P2) -> AngleSet {
     AngleSet::around(angle_of(&(c - p)), (d / (2.0 * r)).acos())
 }
 
-/// Angles whose circle point, seen from `c`, lies at an angle in `[a0, a0 + w]`.
-fn wedge(p: &P2, r: f64, c: P2, a0: f64, w: f64) -> AngleSet {
+/// Angles whose circle point, seen from `c`, lies at an angle in `[a0, a0 + w]` (rays `d0`
+/// and `d1` at the two ends).
+fn wedge(p: &P2, r: f64, c: P2, a0: f64, w: f64, d0: V2, d1: V2) -> AngleSet {
     let v = p - c;
-    let d0 = V2::new(a0.cos(), a0.sin());
-    let d1 = V2::new((a0 + w).cos(), (a0 + w).sin());
     // Left of the first ray: cross(d0, v + R u) ≥ 0, i.e. cross(d0, v) + R cos(θ − a0 − π/2) ≥ 0.
     let h1 = AngleSet::band(cross2(&d0, &v), r, a0 + FRAC_PI_2, 0.0, f64::INFINITY);
     // Right of the second ray: cross(v + R u, d1) ≥ 0, i.e. cross(v, d1) + R cos(θ − a1 + π/2) ≥ 0.
@@ -81,6 +112,8 @@ pub struct Cut {
     boxes: Vec<(P2, P2)>,
     /// Grid cell of the low corner of each piece's box.
     first: Vec<(i64, i64)>,
+    /// Constants of each piece for its angle sets.
+    shapes: Vec<Shape>,
     cell: f64,
     /// Pieces (ascending) by the grid cells their boxes meet.
     grid: HashMap<(i64, i64), Vec<usize>>,
@@ -103,7 +136,8 @@ impl Cut {
                 }
             }
         }
-        Cut { radius, pieces, boxes, first, cell, grid }
+        let shapes = pieces.iter().map(Shape::of).collect();
+        Cut { radius, pieces, boxes, first, shapes, cell, grid }
     }
 
     /// The part of the circle at `p` (radians) not removed by pieces `0..before` of `self`
@@ -127,13 +161,13 @@ impl Cut {
         let latest = recent
             .iter()
             .rev()
-            .map(|s| (s, s.bounds()))
-            .chain((old..before).rev().map(|j| (&self.pieces[j], self.boxes[j])));
-        for (s, b) in latest {
+            .map(|s| (s, s.bounds(), None))
+            .chain((old..before).rev().map(|j| (&self.pieces[j], self.boxes[j], Some(&self.shapes[j]))));
+        for (s, b, shape) in latest {
             if !touches(&b) || screen.as_ref().is_some_and(|q| !q.iter().any(|q| boxes_within(&b, q, reach))) {
                 continue;
             }
-            all.extend(removed_by(p, r, s).0);
+            all.extend(shape.map_or_else(|| removed_by(p, r, s), |k| removed_shaped(p, r, s, k)).0);
             taken += 1;
             if taken % SCREEN_EVERY == 0 {
                 merge(&mut all);
@@ -158,7 +192,7 @@ impl Cut {
                         {
                             continue;
                         }
-                        all.extend(removed_by(p, r, &self.pieces[j]).0);
+                        all.extend(removed_shaped(p, r, &self.pieces[j], &self.shapes[j]).0);
                         taken += 1;
                         if taken % SCREEN_EVERY == 0 {
                             merge(&mut all);
