@@ -9,6 +9,8 @@
 //! levels once; `levels`: each region offset of such a pocket timed alone).
 
 use camkit::contour::offset::{Side, check_offset, offset_contour};
+use camkit::contour::pocket::{Direction, Passes, PocketOptions};
+use camkit::contour::region::Region;
 use camkit::contour::{Contour, OffsetOptions, Vertex};
 use camkit::geom::P2;
 use cavalier_contours::polyline::{PlineOffsetOptions, PlineSource, PlineSourceMut, Polyline};
@@ -25,6 +27,14 @@ fn best<R>(runs: usize, mut f: impl FnMut() -> R) -> (f64, R) {
         t = t.min(s.elapsed().as_secs_f64());
     }
     (t * 1e3, r)
+}
+
+/// The region of `c` and the options of a climb pocket to empty at radius |d|, step 2.
+fn pocket_of(c: &Contour, d: f64, offset: OffsetOptions) -> (Vec<Region>, PocketOptions) {
+    let (rs, _) = camkit::contour::region::regions(std::slice::from_ref(c)).expect("a region");
+    let po =
+        PocketOptions { radius: d.abs(), step: 2.0, passes: Passes::UntilEmpty, direction: Direction::Climb, offset };
+    (rs, po)
 }
 
 fn main() {
@@ -67,30 +77,14 @@ fn main() {
     }
     if args.get(4).is_some_and(|s| s == "pocket1") {
         // Our pocket to empty once (radius D, step 2), for instruction counts.
-        use camkit::contour::pocket::{Direction, Passes, PocketOptions, pocket};
-        let (rs, _) = camkit::contour::region::regions(std::slice::from_ref(&c)).expect("a region");
-        let po = PocketOptions {
-            radius: d.abs(),
-            step: 2.0,
-            passes: Passes::UntilEmpty,
-            direction: Direction::Climb,
-            offset: opts,
-        };
-        let p = pocket(&rs, &po).expect("pocket");
+        let (rs, po) = pocket_of(&c, d, opts);
+        let p = camkit::contour::pocket::pocket(&rs, &po).expect("pocket");
         println!("pocket: {} passes, {} kernel runs", p.passes.len(), p.attempts);
         return;
     }
     if args.get(4).is_some_and(|s| s == "pocket") {
-        use camkit::contour::pocket::{Direction, Passes, PocketOptions, pocket};
-        let (rs, _) = camkit::contour::region::regions(std::slice::from_ref(&c)).expect("a region");
-        let po = PocketOptions {
-            radius: d.abs(),
-            step: 2.0,
-            passes: Passes::UntilEmpty,
-            direction: Direction::Climb,
-            offset: opts,
-        };
-        let (ms, p) = best(2, || pocket(&rs, &po));
+        let (rs, po) = pocket_of(&c, d, opts);
+        let (ms, p) = best(2, || camkit::contour::pocket::pocket(&rs, &po));
         let p = p.expect("pocket");
         println!(
             "pocket: {ms:.1} ms, {} passes, {} kernel runs, {} clean-ups",
