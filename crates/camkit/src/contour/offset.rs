@@ -156,35 +156,26 @@ fn verified(
     opts: &OffsetOptions,
     kernel: impl Fn(&[&Contour], Eps, Option<&Index>) -> Vec<Contour>,
 ) -> Result<Offset, OffsetError> {
-    verified_from(input, input, d, side, closed, opts, false, kernel)
+    verified_from(&SegSet::new(input.iter().copied()), input, input, d, side, closed, opts, false, kernel)
+}
+
+/// True if the quadtree proof ([`SegSet::covers`]) shows that no point inside the pieces of
+/// `set` lies `d − tol` or more from them: an inward offset by `d` is empty.
+fn proved_empty(set: &SegSet, d: f64, opts: &OffsetOptions) -> bool {
+    set.covers(d - opts.tol - tol::ROUNDOFF_ABS, COVER_BUDGET)
 }
 
 /// Cells of the quadtree that may show an inward region offset empty before the kernel runs.
 const COVER_BUDGET: usize = 1024;
 
 /// As [`verified`], but the kernel offsets `source` (loops already offset from `input`) while
-/// the result is verified against `input` at distance `d`. With `inward`, the region inside
-/// `input` is first tried for a cheap proof that it has no point `d − tol` from its loops
-/// ([`SegSet::covers`]): then no result but none can verify, and none is verified and returned
-/// without a kernel run.
+/// the result is verified against `input` at distance `d`; `set` holds `input`'s pieces
+/// (`SegSet::new(input)`, made by the caller so that several offsets of one region, the levels
+/// of a pocket, share them). With `inward`, the region inside `input` is first tried for a
+/// cheap proof that it has no point `d − tol` from its loops ([`proved_empty`]): then no result
+/// but none can verify, and none is verified and returned without a kernel run.
 #[allow(clippy::too_many_arguments)]
 fn verified_from(
-    source: &[&Contour],
-    input: &[&Contour],
-    d: f64,
-    side: f64,
-    closed: bool,
-    opts: &OffsetOptions,
-    inward: bool,
-    kernel: impl Fn(&[&Contour], Eps, Option<&Index>) -> Vec<Contour>,
-) -> Result<Offset, OffsetError> {
-    verified_with_set(&SegSet::new(input.iter().copied()), source, input, d, side, closed, opts, inward, kernel)
-}
-
-/// [`verified_from`] with `input`'s pieces already in `set` (`SegSet::new(input)`), so that
-/// several offsets of one region (the levels of a pocket) share them.
-#[allow(clippy::too_many_arguments)]
-fn verified_with_set(
     set: &SegSet,
     source: &[&Contour],
     input: &[&Contour],
@@ -196,7 +187,7 @@ fn verified_with_set(
     kernel: impl Fn(&[&Contour], Eps, Option<&Index>) -> Vec<Contour>,
 ) -> Result<Offset, OffsetError> {
     if inward
-        && set.covers(d - opts.tol - tol::ROUNDOFF_ABS, COVER_BUDGET)
+        && proved_empty(set, d, opts)
         && let Ok(check) = verify(set, &[], d, side, closed, opts.tol, opts.self_crossing_input)
     {
         return Ok(Offset { contours: Vec::new(), check, attempts: 0, cleaned: false });
@@ -294,8 +285,7 @@ pub fn offset_contour(c: &Contour, d: f64, side: Side, opts: &OffsetOptions) -> 
 /// Offsets a region inward (into the material to remove) by `d` (mm, > 0), verified: closed loops,
 /// counter-clockwise around what remains and clockwise around islands.
 pub fn offset_region(region: &Region, d: f64, opts: &OffsetOptions) -> Result<Offset, OffsetError> {
-    let loops = region.loops();
-    verified_from(&loops, &loops, d, 1.0, true, opts, true, |source, eps, _| shape_offset(source, d, eps))
+    offset_region_in(region, &RegionPieces::new(region), d, opts)
 }
 
 /// The pieces of a region's loops, made once for several offsets of it ([`offset_region_in`],
@@ -309,10 +299,10 @@ impl RegionPieces {
     }
 
     /// The first of `distances` (increasing) at which an inward offset of the region is shown
-    /// empty by the cheap proof that [`offset_region`] tries first ([`SegSet::covers`]), if any.
+    /// empty by the cheap proof that [`offset_region`] tries first ([`proved_empty`]), if any.
     /// That offset and every deeper one are empty (each lies inside the one before it).
     pub(crate) fn first_empty_level(&self, distances: &[f64], opts: &OffsetOptions) -> Option<usize> {
-        let empty = |k: usize| self.0.covers(distances[k] - opts.tol - tol::ROUNDOFF_ABS, COVER_BUDGET);
+        let empty = |k: usize| proved_empty(&self.0, distances[k], opts);
         // The proof only gets easier with depth: bisect for the first level it holds at.
         let (mut lo, mut hi) = (0, distances.len().checked_sub(1)?);
         if !empty(hi) {
@@ -334,9 +324,7 @@ pub(crate) fn offset_region_in(
     opts: &OffsetOptions,
 ) -> Result<Offset, OffsetError> {
     let loops = region.loops();
-    verified_with_set(&pieces.0, &loops, &loops, d, 1.0, true, opts, true, |source, eps, _| {
-        shape_offset(source, d, eps)
-    })
+    verified_from(&pieces.0, &loops, &loops, d, 1.0, true, opts, true, |source, eps, _| shape_offset(source, d, eps))
 }
 
 /// Offsets `loops` (a region already offset from `input`'s loops, oriented as a region) inward by
@@ -348,7 +336,18 @@ pub fn offset_region_further(
     total: f64,
     opts: &OffsetOptions,
 ) -> Result<Offset, OffsetError> {
-    verified_from(loops, &input.loops(), total, 1.0, true, opts, false, |source, eps, _| shape_offset(source, rel, eps))
+    let input = input.loops();
+    verified_from(
+        &SegSet::new(input.iter().copied()),
+        loops,
+        &input,
+        total,
+        1.0,
+        true,
+        opts,
+        false,
+        |source, eps, _| shape_offset(source, rel, eps),
+    )
 }
 
 /// Verifies offsets made elsewhere (another kernel, another run) by the check every result of
