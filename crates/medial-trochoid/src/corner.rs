@@ -176,7 +176,6 @@ pub fn fit_corners(
     arc_margin_deg: f64,
     step: f64,
 ) -> Vec<Result<(f64, f64), (f64, f64)>> {
-    let r = before.radius;
     let corners = inside_corners(c);
     let mut out: Vec<Result<(f64, f64), (f64, f64)>> = Vec::with_capacity(corners.len());
     // Corner index of each vertex (one lookup per vertex, not a search per vertex per trial).
@@ -200,17 +199,7 @@ pub fn fit_corners(
         let at = vertex + arcs_before;
         if at >= 1 && at + 1 < plain.vertices.len() {
             let pieces: Vec<Seg> = (0..=at).map(|q| plain.seg(q)).collect();
-            let mut max = 0.0f64;
-            for (pk, piece) in pieces.iter().enumerate().skip(at - 1) {
-                let len = piece.length();
-                let (lo, hi) =
-                    if pk + 1 == at { (((len - r) / len).max(0.0), 1.0) } else { (0.0, (2.0 * r / len).min(1.0)) };
-                let n = ((hi - lo) * len / step).ceil().max(1.0) as usize;
-                for q in 1..=n {
-                    let t = lo + (hi - lo) * q as f64 / n as f64;
-                    max = max.max(before.engagement_after(&pieces, pk, t).to_degrees());
-                }
-            }
+            let (max, _) = near_corner(before, &pieces, at - 1, step);
             if max <= limit_deg {
                 out.push(Ok((0.0, max)));
                 continue;
@@ -230,25 +219,7 @@ pub fn fit_corners(
             }
             let pieces: Vec<Seg> = (0..=k + 1).map(|q| rounded.seg(q)).collect();
             // Lines at the limit, the arc (sampled elsewhere by the program) at a margin under it.
-            let (mut max, mut arc_max) = (0.0f64, 0.0f64);
-            for (pk, piece) in pieces.iter().enumerate().skip(k - 1) {
-                let len = piece.length();
-                let (lo, hi) = match pk {
-                    _ if pk + 1 == k => ((len - r) / len, 1.0),
-                    _ if pk == k => (0.0, 1.0),
-                    _ => (0.0, (2.0 * r / len).min(1.0)),
-                };
-                let h = if pk == k { step / 2.5 } else { step };
-                let n = ((hi - lo.max(0.0)) * len / h).ceil().max(1.0) as usize;
-                for q in 1..=n {
-                    let t = lo.max(0.0) + (hi - lo.max(0.0)) * q as f64 / n as f64;
-                    let e = before.engagement_after(&pieces, pk, t).to_degrees();
-                    max = max.max(e);
-                    if pk == k {
-                        arc_max = arc_max.max(e);
-                    }
-                }
-            }
+            let (max, arc_max) = near_corner(before, &pieces, k - 1, step);
             if max <= limit_deg && arc_max <= limit_deg - arc_margin_deg {
                 found = Some((used, max));
                 break;
@@ -260,6 +231,36 @@ pub fn fit_corners(
         out.push(found.ok_or(best));
     }
     out
+}
+
+/// Largest engagement (degrees) near a corner of the pass `pieces` (from its start to the piece
+/// after the corner), and the largest on the pieces between `pieces[first]` and the last (the
+/// corner's arc, if any). Samples every `step` mm along the last tool radius of `pieces[first]`
+/// and the first two tool radii of the last piece, and every `step / 2.5` mm between.
+fn near_corner(before: &Cut, pieces: &[Seg], first: usize, step: f64) -> (f64, f64) {
+    let r = before.radius;
+    let last = pieces.len() - 1;
+    let (mut max, mut arc_max) = (0.0f64, 0.0f64);
+    for (pk, piece) in pieces.iter().enumerate().skip(first) {
+        let len = piece.length();
+        let (lo, hi, h) = if pk == first {
+            (((len - r) / len).max(0.0), 1.0, step)
+        } else if pk == last {
+            (0.0, (2.0 * r / len).min(1.0), step)
+        } else {
+            (0.0, 1.0, step / 2.5)
+        };
+        let n = ((hi - lo) * len / h).ceil().max(1.0) as usize;
+        for q in 1..=n {
+            let t = lo + (hi - lo) * q as f64 / n as f64;
+            let e = before.engagement_after(pieces, pk, t).to_degrees();
+            max = max.max(e);
+            if pk != first && pk != last {
+                arc_max = arc_max.max(e);
+            }
+        }
+    }
+    (max, arc_max)
 }
 
 /// Engagement (radians) of a tool of radius `r` on a circular path of radius `rho` that cuts

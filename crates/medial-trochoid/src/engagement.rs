@@ -152,7 +152,7 @@ impl Cut {
     /// the merged union, hence the angle, is the same to the bit as with every piece taken.
     fn free(&self, p: &P2, before: usize, recent: &[Seg]) -> f64 {
         let r = self.radius;
-        let touches = |b: &(P2, P2)| within_reach(b, p, 2.0 * r);
+        let touches = |b: &(P2, P2)| boxes_within(b, &(*p, *p), 2.0 * r);
         let reach = r + SCREEN_MARGIN;
         let mut all: Vec<(f64, f64)> = Vec::new();
         let mut screen: Option<Vec<(P2, P2)>> = None;
@@ -317,17 +317,11 @@ fn hull(boxes: &[(P2, P2)]) -> Option<(P2, P2)> {
         .reduce(|a, b| (P2::new(a.0.x.min(b.0.x), a.0.y.min(b.0.y)), P2::new(a.1.x.max(b.1.x), a.1.y.max(b.1.y))))
 }
 
-/// True if the boxes `a` and `b` come nearer than `reach` to each other.
+/// True if the boxes `a` and `b` come nearer than `reach` to each other (a point is the box
+/// `(p, p)`).
 fn boxes_within(a: &(P2, P2), b: &(P2, P2), reach: f64) -> bool {
     let dx = (a.0.x - b.1.x).max(b.0.x - a.1.x).max(0.0);
     let dy = (a.0.y - b.1.y).max(b.0.y - a.1.y).max(0.0);
-    dx * dx + dy * dy < reach * reach
-}
-
-/// True if the box `(lo, hi)` comes nearer than `reach` to `p`.
-fn within_reach((lo, hi): &(P2, P2), p: &P2, reach: f64) -> bool {
-    let dx = (lo.x - p.x).max(p.x - hi.x).max(0.0);
-    let dy = (lo.y - p.y).max(p.y - hi.y).max(0.0);
     dx * dx + dy * dy < reach * reach
 }
 
