@@ -147,14 +147,15 @@ fn cleaned(c: &Contour, eps: f64) -> Contour {
 }
 
 /// Runs `kernel` over the epsilon ladder on the input, then on the cleaned input, returning the
-/// first result that verifies against the original input.
+/// first result that verifies against the original input. `kernel` offsets by its caller's
+/// distance plus the nudge it is given (see [`NUDGES`]).
 fn verified(
     input: &[&Contour],
     d: f64,
     side: f64,
     closed: bool,
     opts: &OffsetOptions,
-    kernel: impl Fn(&[&Contour], Eps, Option<&Index>) -> Vec<Contour>,
+    kernel: impl Fn(&[&Contour], f64, Eps, Option<&Index>) -> Vec<Contour>,
 ) -> Result<Offset, OffsetError> {
     verified_from(&SegSet::new(input.iter().copied()), input, input, d, side, closed, opts, false, kernel)
 }
@@ -184,7 +185,7 @@ fn verified_from(
     closed: bool,
     opts: &OffsetOptions,
     inward: bool,
-    kernel: impl Fn(&[&Contour], Eps, Option<&Index>) -> Vec<Contour>,
+    kernel: impl Fn(&[&Contour], f64, Eps, Option<&Index>) -> Vec<Contour>,
 ) -> Result<Offset, OffsetError> {
     if inward
         && proved_empty(set, d, opts)
@@ -198,7 +199,7 @@ fn verified_from(
     let scale = if alone { ladder_of_one(set) } else { None }.unwrap_or_else(|| ladder(source));
     let mut attempts = 0;
     let mut defect = None;
-    for was_cleaned in [false, true] {
+    for (nudge, was_cleaned) in NUDGES.iter().flat_map(|k| [(k * opts.tol, false), (k * opts.tol, true)]) {
         let tidy: Vec<Contour>;
         let tidy_refs: Vec<&Contour>;
         let (loops, index) = if was_cleaned {
@@ -213,7 +214,7 @@ fn verified_from(
         };
         for &eps in &scale {
             attempts += 1;
-            let Some(mut out) = guarded(|| kernel(loops, eps, index)) else {
+            let Some(mut out) = guarded(|| kernel(loops, nudge, eps, index)) else {
                 defect = Some(Defect::Kernel);
                 continue;
             };
@@ -228,6 +229,13 @@ fn verified_from(
     }
     Err(OffsetError { attempts, defect: defect.expect("at least one attempt") })
 }
+
+/// Offset distances tried, as fractions of the tolerance added to the asked one: first exact;
+/// then, if no run verifies, just inside and just outside it. Walls exactly 2d apart offset by d
+/// give loops that run along each other, which the kernel cannot return as a valid set; half the
+/// tolerance inside, they join as one loop along the middle (a sliver the tool runs up and back),
+/// every point still within the tolerance of d.
+const NUDGES: [f64; 3] = [0.0, -0.5, 0.5];
 
 /// True if `c` is longer than `len` (mm): its length summed piece by piece stops once past it
 /// (the partial sums only grow, so this is `c.length() > len`).
@@ -264,11 +272,10 @@ fn guarded(kernel: impl FnOnce() -> Vec<Contour>) -> Option<Vec<Contour>> {
 /// open pieces; of a closed one, closed loops (which may touch at a vertex), unless it crosses
 /// itself and `opts.self_crossing_input` allows that: then loops and open stretches.
 pub fn offset_contour(c: &Contour, d: f64, side: Side, opts: &OffsetOptions) -> Result<Offset, OffsetError> {
-    let signed = d * side.sign();
     // A closed contour that crosses itself has no side that stays inside: its offset is what the
     // tool can cut on that side, loops and open stretches ending where they would gouge.
     let closed = c.closed && !(opts.self_crossing_input && c.self_crossing().is_some());
-    verified(&[c], d, side.sign(), closed, opts, |source, (pos, dist), index| {
+    verified(&[c], d, side.sign(), closed, opts, |source, nudge, (pos, dist), index| {
         let pline: Polyline<f64> = source[0].to_pline();
         let o = PlineOffsetOptions {
             aabb_index: index,
@@ -278,7 +285,7 @@ pub fn offset_contour(c: &Contour, d: f64, side: Side, opts: &OffsetOptions) -> 
             touching_loop_behavior: TouchingLoopBehavior::Separate,
             ..Default::default()
         };
-        pline.parallel_offset_opt(signed, &o).iter().map(Contour::from_pline).collect()
+        pline.parallel_offset_opt((d + nudge) * side.sign(), &o).iter().map(Contour::from_pline).collect()
     })
 }
 
@@ -324,7 +331,9 @@ pub(crate) fn offset_region_in(
     opts: &OffsetOptions,
 ) -> Result<Offset, OffsetError> {
     let loops = region.loops();
-    verified_from(&pieces.0, &loops, &loops, d, 1.0, true, opts, true, |source, eps, _| shape_offset(source, d, eps))
+    verified_from(&pieces.0, &loops, &loops, d, 1.0, true, opts, true, |source, nudge, eps, _| {
+        shape_offset(source, d + nudge, eps)
+    })
 }
 
 /// Offsets `loops` (a region already offset from `input`'s loops, oriented as a region) inward by
@@ -346,7 +355,7 @@ pub fn offset_region_further(
         true,
         opts,
         false,
-        |source, eps, _| shape_offset(source, rel, eps),
+        |source, nudge, eps, _| shape_offset(source, rel + nudge, eps),
     )
 }
 
@@ -474,6 +483,35 @@ mod tests {
         let apart = offset_contour(&c, 1.001, Side::Left, &OffsetOptions::default()).unwrap();
         assert_eq!(apart.contours.len(), 2);
         assert!(apart.contours[0].crossing_with(&apart.contours[1]).is_none());
+    }
+
+    /// Two 20 × 20 rooms joined by a passage whose parallel walls are exactly 2d apart: at d
+    /// the walls' offsets run along each other, which no run returns as valid loops; half the
+    /// tolerance inside, the offset runs up the passage's middle and back.
+    #[test]
+    fn a_passage_exactly_2d_wide_is_cut_along_its_middle() {
+        let c = Contour::polygon(
+            &[(0.0, 0.0), (20.0, 0.0), (20.0, 9.0), (30.0, 9.0), (30.0, 0.0), (50.0, 0.0), (50.0, 20.0)]
+                .into_iter()
+                .chain([(30.0, 20.0), (30.0, 11.0), (20.0, 11.0), (20.0, 20.0), (0.0, 20.0)])
+                .map(|(x, y)| P2::new(x, y))
+                .collect::<Vec<_>>(),
+            true,
+        );
+        let opts = OffsetOptions::default();
+        let (regions, _) = crate::contour::region::regions(std::slice::from_ref(&c)).expect("one outer loop");
+        let on_middle = |loops: &[Contour]| {
+            [21.0, 25.0, 29.0].into_iter().all(|x| {
+                let mid = P2::new(x, 10.0);
+                loops.iter().flat_map(Contour::segs).any(|s| s.distance_to(&mid) <= opts.tol)
+            })
+        };
+        // Verified results both (the contour's as the rooms and the passage's sliver touching
+        // them, the region's as one loop), each through the middle of the passage.
+        let o = offset_contour(&c, 1.0, Side::Left, &opts).unwrap_or_else(|e| panic!("{e}"));
+        assert!(on_middle(&o.contours));
+        let r = offset_region(&regions[0], 1.0, &opts).unwrap_or_else(|e| panic!("{e}"));
+        assert!(on_middle(&r.contours));
     }
 
     #[test]
