@@ -5,7 +5,7 @@
 
 use super::Contour;
 use super::region::Region;
-use super::verify::{Check, Defect, SegSet, verify};
+use super::verify::{Check, Defect, SegSet, verify, verify_within};
 use crate::tol;
 use cavalier_contours::polyline::{PlineOffsetOptions, PlineSource, Polyline, TouchingLoopBehavior};
 use cavalier_contours::shape_algorithms::{Shape, ShapeOffsetOptions};
@@ -157,7 +157,7 @@ fn verified(
     opts: &OffsetOptions,
     kernel: impl Fn(&[&Contour], f64, Eps, Option<&Index>) -> Vec<Contour>,
 ) -> Result<Offset, OffsetError> {
-    verified_from(&SegSet::new(input.iter().copied()), input, input, d, side, closed, opts, false, kernel)
+    verified_from(&SegSet::new(input.iter().copied()), input, input, d, side, closed, opts, false, &[], kernel)
 }
 
 /// True if the quadtree proof ([`SegSet::covers`]) shows that no point inside the pieces of
@@ -175,6 +175,7 @@ const COVER_BUDGET: usize = 1024;
 /// of a pocket, share them). With `inward`, the region inside `input` is first tried for a
 /// cheap proof that it has no point `d − tol` from its loops ([`proved_empty`]): then no result
 /// but none can verify, and none is verified and returned without a kernel run.
+/// Completeness is asked only inside `scope` (see [`verify_within`]; none: everywhere).
 #[allow(clippy::too_many_arguments)]
 fn verified_from(
     set: &SegSet,
@@ -185,6 +186,7 @@ fn verified_from(
     closed: bool,
     opts: &OffsetOptions,
     inward: bool,
+    scope: &[&Contour],
     kernel: impl Fn(&[&Contour], f64, Eps, Option<&Index>) -> Vec<Contour>,
 ) -> Result<Offset, OffsetError> {
     if inward
@@ -221,7 +223,7 @@ fn verified_from(
             // A loop no longer than the tolerance is round-off where two loops touch (the lens
             // between two tangent circles): the tool would cut nothing there.
             out.retain(|c| longer_than(c, opts.tol));
-            match verify(set, &out, d, side, closed, opts.tol, opts.self_crossing_input) {
+            match verify_within(set, &out, d, side, closed, opts.tol, opts.self_crossing_input, scope) {
                 Ok(check) => return Ok(Offset { contours: out, check, attempts, cleaned: was_cleaned }),
                 Err(e) => defect = Some(e),
             }
@@ -331,13 +333,14 @@ pub(crate) fn offset_region_in(
     opts: &OffsetOptions,
 ) -> Result<Offset, OffsetError> {
     let loops = region.loops();
-    verified_from(&pieces.0, &loops, &loops, d, 1.0, true, opts, true, |source, nudge, eps, _| {
+    verified_from(&pieces.0, &loops, &loops, d, 1.0, true, opts, true, &[], |source, nudge, eps, _| {
         shape_offset(source, d + nudge, eps)
     })
 }
 
 /// Offsets `loops` (a region already offset from `input`'s loops, oriented as a region) inward by
-/// `rel` more, verified against `input` at the total distance `total`.
+/// `rel` more, verified against `input` at the total distance `total` as the part of that offset
+/// inside `loops` (one piece of a pocket level need not hold the other pieces' offsets).
 pub fn offset_region_further(
     loops: &[&Contour],
     rel: f64,
@@ -355,6 +358,7 @@ pub fn offset_region_further(
         true,
         opts,
         false,
+        loops,
         |source, nudge, eps, _| shape_offset(source, rel + nudge, eps),
     )
 }

@@ -323,3 +323,41 @@ fn push(out: &mut Vec<Pass>, cursor: &mut Option<P2>, c: &Contour, dir: Directio
     *cursor = pass.contour.vertices.first().map(|v| v.p);
     out.push(pass);
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::contour::region::regions;
+    use crate::geom::P2;
+
+    /// A 12 × 12 room joined by a 4 mm passage to a 40 × 40 one: the small room runs out of
+    /// levels first and gets its clean-up pass while the large room still has levels at that
+    /// depth. The clean-up is the offset of the small room's piece only, so the large room's
+    /// offset at the same depth is not asked of it.
+    #[test]
+    fn a_shallow_piece_gets_its_clean_up_while_a_deeper_one_goes_on() {
+        let pts = [(0.0, 0.0), (12.0, 0.0), (12.0, 4.0), (22.0, 4.0), (22.0, -14.0), (62.0, -14.0), (62.0, 26.0)]
+            .into_iter()
+            .chain([(22.0, 26.0), (22.0, 8.0), (12.0, 8.0), (12.0, 12.0), (0.0, 12.0)])
+            .map(|(x, y)| P2::new(x, y))
+            .collect::<Vec<_>>();
+        let (regions, _) = regions(&[Contour::polygon(&pts, true)]).expect("one region");
+        let opts = PocketOptions {
+            radius: 1.0,
+            step: 1.7,
+            passes: Passes::UntilEmpty,
+            direction: Direction::Climb,
+            offset: OffsetOptions::default(),
+        };
+        let p = pocket(&regions, &opts).unwrap_or_else(|e| panic!("{e:?}"));
+        let small_room = |pass: &Pass| pass.contour.vertices.iter().all(|v| v.p.x < 12.0);
+        let clean_up =
+            p.passes.iter().find(|pass| pass.clean_up && small_room(pass)).expect("the small room's clean-up");
+        // It reaches the small room's centre within the tool radius, deeper than its last level.
+        let centre = P2::new(6.0, 6.0);
+        let near = clean_up.contour.segs().map(|s| s.distance_to(&centre)).fold(f64::INFINITY, f64::min);
+        assert!(near <= opts.radius, "the centre is {near} mm from the clean-up");
+        assert!(clean_up.distance > 4.4 && clean_up.distance < 6.0, "{}", clean_up.distance);
+        assert!(p.passes.iter().any(|pass| !small_room(pass) && pass.distance > clean_up.distance));
+    }
+}

@@ -805,16 +805,34 @@ pub(crate) fn verify(
     tol: f64,
     crossing_input: bool,
 ) -> Result<Check, Defect> {
-    verify_with(input, output, &Spec { d, side, tol, shortcuts: true }, closed, crossing_input)
+    verify_within(input, output, d, side, closed, tol, crossing_input, &[])
 }
 
-/// [`verify`] with its settings spelled out.
+/// [`verify`] of the part of the offset that lies inside `scope` (loops oriented as a region;
+/// none: all of it): a valid offset point outside `scope` need not lie on `output`. The clean-up
+/// pass of one piece of a pocket level is the offset of the region inside that piece only.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn verify_within(
+    input: &SegSet,
+    output: &[Contour],
+    d: f64,
+    side: f64,
+    closed: bool,
+    tol: f64,
+    crossing_input: bool,
+    scope: &[&Contour],
+) -> Result<Check, Defect> {
+    verify_with(input, output, &Spec { d, side, tol, shortcuts: true }, closed, crossing_input, scope)
+}
+
+/// [`verify_within`] with its settings spelled out.
 fn verify_with(
     input: &SegSet,
     output: &[Contour],
     spec: &Spec,
     closed: bool,
     crossing_input: bool,
+    scope: &[&Contour],
 ) -> Result<Check, Defect> {
     let (d, tol) = (spec.d, spec.tol);
     for c in output {
@@ -898,7 +916,8 @@ fn verify_with(
                 input.closer(&c, d - 0.25 * tol, &[input.prev[i], input.next[i], scratch.hit], &mut scratch.stack);
             let invalid = hit.is_some();
             scratch.hit = hit.or(scratch.hit);
-            (!invalid).then_some(c)
+            let outside = || !scope.is_empty() && scope.iter().map(|l| l.winding_number(&c)).sum::<i32>() == 0;
+            (!invalid && !outside()).then_some(c)
         });
     if let Some(c) = missing {
         return Err(Defect::Missing(c));
@@ -1149,8 +1168,8 @@ mod tests {
             let Ok(o) = offset_contour(&c, d, side, &OffsetOptions::default()) else { return Ok(()) };
             let input = SegSet::new([&c]);
             let spec = |shortcuts| Spec { d: d + skew, side: side.sign(), tol: 1e-6, shortcuts };
-            let fast = verify_with(&input, &o.contours, &spec(true), true, false);
-            let full = verify_with(&input, &o.contours, &spec(false), true, false);
+            let fast = verify_with(&input, &o.contours, &spec(true), true, false, &[]);
+            let full = verify_with(&input, &o.contours, &spec(false), true, false, &[]);
             match (fast, full) {
                 (Ok(f), Ok(g)) => {
                     prop_assert!((f.below - g.below).abs() <= tol::ROUNDOFF_ABS, "below {} vs {}", f.below, g.below);
