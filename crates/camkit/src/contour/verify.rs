@@ -808,6 +808,10 @@ pub(crate) fn verify(
     verify_within(input, output, d, side, closed, tol, crossing_input, &[])
 }
 
+/// How far, in tolerances, along an input piece the completeness probe looks on either side for
+/// valid offset points before it counts a lone valid one as a point the offset shrank to.
+const ISOLATED: f64 = 2.0;
+
 /// [`verify`] of the part of the offset that lies inside `scope` (loops oriented as a region;
 /// none: all of it): a valid offset point outside `scope` need not lie on `output`. The clean-up
 /// pass of one piece of a pocket level is the offset of the region inside that piece only.
@@ -905,19 +909,34 @@ fn verify_with(
             if t.length() <= tol {
                 return None;
             }
-            let tangent = t.tangent_at(0.5);
-            let c = t.point_at(0.5) + V2::new(-tangent.y, tangent.x) * (spec.side * d);
+            let raw = |at: f64| {
+                let tangent = t.tangent_at(at);
+                t.point_at(at) + V2::new(-tangent.y, tangent.x) * (spec.side * d)
+            };
+            let c = raw(0.5);
             if out.any_within(&c, tol, true, &made[i], &mut scratch.stack) {
                 return None;
             }
             // The piece that showed the previous probe invalid nearly always shows this one too
             // (the probes of a deep offset lie far from their own pieces).
-            let hit =
-                input.closer(&c, d - 0.25 * tol, &[input.prev[i], input.next[i], scratch.hit], &mut scratch.stack);
-            let invalid = hit.is_some();
-            scratch.hit = hit.or(scratch.hit);
-            let outside = || !scope.is_empty() && scope.iter().map(|l| l.winding_number(&c)).sum::<i32>() == 0;
-            (!invalid && !outside()).then_some(c)
+            let mut invalid_at = |p: &P2| {
+                let hit =
+                    input.closer(p, d - 0.25 * tol, &[input.prev[i], input.next[i], scratch.hit], &mut scratch.stack);
+                scratch.hit = hit.or(scratch.hit);
+                hit.is_some()
+            };
+            if invalid_at(&c) {
+                return None;
+            }
+            // A valid probe whose raw offset is invalid `ISOLATED · tol` along the piece on both
+            // sides lies where the offset shrinks to a point: round-off, as a loop no longer than
+            // the tolerance is (a pocket level exactly as deep as the region).
+            let step = ISOLATED * tol / t.length();
+            if step < 0.5 && invalid_at(&raw(0.5 - step)) && invalid_at(&raw(0.5 + step)) {
+                return None;
+            }
+            let outside = !scope.is_empty() && scope.iter().map(|l| l.winding_number(&c)).sum::<i32>() == 0;
+            (!outside).then_some(c)
         });
     if let Some(c) = missing {
         return Err(Defect::Missing(c));
