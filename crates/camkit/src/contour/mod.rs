@@ -22,6 +22,7 @@ use crate::geom::dist::{
     segment_segment_min,
 };
 use crate::geom::{Arc2, P2, V2, arc::angle_of, cross2};
+use crate::tol;
 use cavalier_contours::polyline::{PlineCreation, PlineSource, PlineSourceMut, PlineVertex, Polyline};
 use std::f64::consts::{FRAC_PI_2, PI};
 
@@ -315,9 +316,39 @@ impl Contour {
     }
 
     /// First point where the contour crosses or touches itself, if any (pieces that do not
-    /// follow each other meet), by exact distances.
+    /// follow each other meet, or consecutive ones meet away from their joint), by exact
+    /// distances.
     pub fn self_crossing(&self) -> Option<P2> {
-        verify::SegSet::new([self]).first_crossing()
+        verify::SegSet::new([self]).first_crossing().or_else(|| self.folded_joint())
+    }
+
+    /// First point where two consecutive pieces meet other than at their joint: a turn back
+    /// along the way it came, or an arc that curls across its neighbour. Each piece is measured
+    /// without the first and last `POINT_EPS` of its length, where it touches its neighbours.
+    fn folded_joint(&self) -> Option<P2> {
+        let n = self.seg_count();
+        let inner = |i: usize, cut: f64| {
+            let s = self.seg(i);
+            let k = cut / s.length();
+            (k < 0.5).then(|| s.sub(k, 1.0 - k))
+        };
+        let meet = |i: usize, cut: f64| {
+            let (a, b) = (inner(i, cut)?, inner((i + 1) % n, cut)?);
+            (a.min_distance(&b) == 0.0).then_some((a, b))
+        };
+        let joints = if self.closed && n > 1 { n } else { n.saturating_sub(1) };
+        (0..joints).find_map(|i| {
+            let mut pair = meet(i, tol::POINT_EPS)?;
+            // Name the crossing, not the joint next to it: cut away more of the joint while the
+            // pieces still meet, so that the nearest points found are those of the crossing.
+            for cut in [1e-6, 1e-4, 1e-2, 1.0] {
+                match meet(i, cut) {
+                    Some(p) => pair = p,
+                    None => break,
+                }
+            }
+            Some(verify::meeting_point(&pair.0, &pair.1))
+        })
     }
 
     /// First point where this contour and `other` cross or touch, if any.
@@ -356,6 +387,39 @@ impl Contour {
 mod tests {
     use super::*;
     use std::f64::consts::TAU;
+
+    /// Consecutive pieces that meet away from their joint cross: two arcs of a random star
+    /// (found by fuzzing `offset`) that leave their joint 174° apart and curl across each other
+    /// just below it, and a line that turns straight back. Smooth and sharp joints that stay
+    /// open do not.
+    #[test]
+    fn consecutive_pieces_that_fold_across_each_other_cross() {
+        let v = |x: f64, y: f64, bulge: f64| Vertex { p: P2::new(x, y), bulge };
+        #[rustfmt::skip]
+        let star = Contour { vertices: vec![
+            v(72.245670, 50.000000, 0.0), v(73.412140, 62.287639, -0.256903699), v(57.462055, 60.810653, 0.060706490),
+            v(51.702284, 64.019567, -0.378702207), v(40.887603, 74.027415, -0.389164237), v(34.655219, 63.594289, 0.0),
+            v(31.714181, 54.507050, 0.0), v(34.679328, 46.223793, 0.0), v(34.444884, 36.219370, 0.0),
+            v(40.042799, 23.745018, 0.0), v(52.292193, 31.122094, -0.316331690), v(63.027931, 31.125784, 0.0),
+            v(72.852591, 38.006035, 0.0),
+        ], closed: true };
+        assert!(verify::SegSet::new([&star]).first_crossing().is_none(), "no two pieces apart from each other meet");
+        let x = star.self_crossing().expect("the arcs either side of (40.89, 74.03) cross");
+        assert!((x - P2::new(40.887603, 74.027415)).norm() > 1e-3, "{x}");
+        assert!(star.seg(3).distance_to(&x) < 1e-9 && star.seg(4).distance_to(&x) < 1e-9);
+        let mut flat = star.clone();
+        flat.vertices[3].bulge = 0.0;
+        assert_eq!(flat.self_crossing(), None, "a straight piece there leaves a sharp, open spike");
+        let back =
+            Contour::polygon(&[P2::new(0.0, 0.0), P2::new(4.0, 0.0), P2::new(2.0, 0.0), P2::new(2.0, 3.0)], true);
+        assert!(back.self_crossing().is_some(), "turning back along the line overlaps it");
+        let stadium = Contour {
+            vertices: vec![v(0.0, 0.0, 0.0), v(4.0, 0.0, 1.0), v(4.0, 2.0, 0.0), v(0.0, 2.0, 1.0)],
+            closed: true,
+        };
+        assert_eq!(stadium.self_crossing(), None);
+        assert_eq!(Contour::circle(P2::new(0.0, 0.0), 2.0, 0.3, true).self_crossing(), None);
+    }
 
     #[test]
     fn bulge_round_trip_and_area() {

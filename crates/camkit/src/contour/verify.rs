@@ -1124,6 +1124,8 @@ mod tests {
             use crate::contour::offset::{RegionPieces, offset_region};
             use crate::contour::pocket::{Direction, Passes, PocketOptions, pocket};
             let c = star(&radii, &bulges);
+            // A spike's arc can leave its tip on the wrong side of the other flank: no region.
+            prop_assume!(c.self_crossing().is_none());
             let (rs, _) = crate::contour::region::regions(std::slice::from_ref(&c)).unwrap();
             let opts = OffsetOptions::default();
             let distances: Vec<f64> = (0..48).map(|k| radius + k as f64 * step).collect();
