@@ -49,7 +49,7 @@ def find(d, key):
             if f is not None:
                 return f
     return None
-keys = ["largest_engagement_deg", "samples_over_threshold", "link_samples_over_threshold", "no_gouge", "uncleared_stretches", "corner_rests"]
+keys = ["largest_engagement_deg", "samples_over_threshold", "threshold_held", "repair_rounds", "link_samples_over_threshold", "no_gouge", "uncleared_stretches", "trochoid_runs", "corner_rests", "samples"]
 print(f"{sys.argv[1]}-gon: {float(sys.argv[2]):.2f} s", {k: find(r, k) for k in keys})
 PY
   done

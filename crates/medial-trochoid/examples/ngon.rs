@@ -46,7 +46,7 @@ fn main() {
     let secs = t0.elapsed().as_secs_f64();
     let count = |t: Tag| p.trochoidal.program.moves.iter().filter(|m| m.tag == t).count();
     println!(
-        "{n}-gon{}: {secs:.2} s; offset-only: {} samples, {} hot, largest {:.6}°; trochoidal: {} samples, moves trochoid {} contour {} link {}, largest {:.6}°, over {}, links over {}, runs {}, uncleared {}, rests {}",
+        "{n}-gon{}: {secs:.2} s; offset-only: {} samples, {} hot, largest {:.6}°; trochoidal: {} samples, moves trochoid {} contour {} link {}, largest {:.6}°, over {}, links over {}, runs {}, uncleared {}, rests {}, repair rounds {}, left over {}",
         if wavy { " wavy+island" } else { "" },
         p.offset_only.samples.len(),
         p.danger_samples,
@@ -61,5 +61,7 @@ fn main() {
         p.runs.len(),
         p.uncleared.len(),
         p.rests.len(),
+        p.repair_rounds,
+        p.left_over.len(),
     );
 }

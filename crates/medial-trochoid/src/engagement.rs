@@ -151,6 +151,13 @@ impl Cut {
     /// nothing from them, so every arc it would remove lies inside the union already taken and
     /// the merged union, hence the angle, is the same to the bit as with every piece taken.
     fn free(&self, p: &P2, before: usize, recent: &[Seg]) -> f64 {
+        let all = self.removed(p, before, recent);
+        (TAU - all.iter().map(|(a, b)| b - a).sum::<f64>()).max(0.0)
+    }
+
+    /// The merged angle set (radians) of the circle at `p` removed by pieces `0..before` and
+    /// `recent`: the union [`Cut::free`] measures, taken as described there.
+    fn removed(&self, p: &P2, before: usize, recent: &[Seg]) -> Vec<(f64, f64)> {
         let r = self.radius;
         let touches = |b: &(P2, P2)| boxes_within(b, &(*p, *p), 2.0 * r);
         let reach = r + SCREEN_MARGIN;
@@ -206,7 +213,7 @@ impl Cut {
             }
         }
         merge(&mut all);
-        (TAU - all.iter().map(|(a, b)| b - a).sum::<f64>()).max(0.0)
+        all
     }
 
     /// Engagement (radians) at fraction `t` of piece `i`: the part of the tool circle not
@@ -215,6 +222,14 @@ impl Cut {
         let p = self.pieces[i].point_at(t);
         let own: Vec<Seg> = if t > 0.0 { vec![self.pieces[i].sub(0.0, t)] } else { Vec::new() };
         self.free(&p, i, &own)
+    }
+
+    /// The arcs of the tool circle in material at fraction `t` of piece `i` (what
+    /// [`Cut::engagement`] measures), as angle intervals (radians, within [0, 2π)).
+    pub fn material(&self, i: usize, t: f64) -> Vec<(f64, f64)> {
+        let p = self.pieces[i].point_at(t);
+        let own: Vec<Seg> = if t > 0.0 { vec![self.pieces[i].sub(0.0, t)] } else { Vec::new() };
+        gaps(&self.removed(&p, i, &own))
     }
 
     /// Engagement (radians) of a tool standing at `p` after pieces `0..before`: the part of its
@@ -275,20 +290,9 @@ const SCREEN_MARGIN: f64 = 1e-6;
 /// Boxes of the arcs of the circle (centre `p`, radius `r`) outside the merged angle set
 /// `removed`, each arc cut into parts of at most π/8 so that the boxes stay tight.
 fn material_boxes(p: &P2, r: f64, removed: &[(f64, f64)]) -> Vec<(P2, P2)> {
-    let mut gaps = Vec::new();
-    let mut from = 0.0;
-    for &(a, b) in removed {
-        if a > from {
-            gaps.push((from, a));
-        }
-        from = from.max(b);
-    }
-    if from < TAU {
-        gaps.push((from, TAU));
-    }
     let at = |a: f64| P2::new(p.x + r * a.cos(), p.y + r * a.sin());
     let mut out = Vec::new();
-    for (a, b) in gaps {
+    for (a, b) in gaps(removed) {
         let n = ((b - a) / (PI / 8.0)).ceil().max(1.0) as usize;
         for k in 0..n {
             let (a0, a1) = (a + (b - a) * k as f64 / n as f64, a + (b - a) * (k + 1) as f64 / n as f64);
@@ -305,6 +309,22 @@ fn material_boxes(p: &P2, r: f64, removed: &[(f64, f64)]) -> Vec<(P2, P2)> {
             }
             out.push((lo, hi));
         }
+    }
+    out
+}
+
+/// The complement in [0, 2π) of the merged angle set `removed`: the arcs still in material.
+fn gaps(removed: &[(f64, f64)]) -> Vec<(f64, f64)> {
+    let mut out = Vec::new();
+    let mut from = 0.0;
+    for &(a, b) in removed {
+        if a > from {
+            out.push((from, a));
+        }
+        from = from.max(b);
+    }
+    if from < TAU {
+        out.push((from, TAU));
     }
     out
 }
@@ -379,6 +399,9 @@ mod tests {
                 }
                 let exact = brute(r, &p, &before).to_degrees();
                 prop_assert!((e - exact).abs() <= 1e-9, "piece {i} t {t}: {e} vs {exact}");
+                // The material arcs are what the engagement measures.
+                let arcs: f64 = cut.material(i, t).iter().map(|(a, b)| b - a).sum();
+                prop_assert!((arcs.to_degrees() - e).abs() <= 1e-9, "piece {i} t {t}: arcs {arcs} vs {e}");
                 // Standing and after-the-cut forms too.
                 let standing = cut.engagement_at(&p, i).to_degrees();
                 prop_assert!((standing - brute(r, &p, &pieces[..i]).to_degrees()).abs() <= 1e-9);
@@ -415,6 +438,14 @@ mod tests {
             let e = cut.engagement(1, 0.5);
             let exact = (1.0 - ae / r).acos();
             assert!((e - exact).abs() < 1e-9, "ae {ae}: {} vs {}", e.to_degrees(), exact.to_degrees());
+            if ae < r {
+                // In material: from where the first pass's band ends (sin θ = 1 − ae/R) to the
+                // normal ahead of the second (θ = 90°; behind it the pass itself cut).
+                let arcs = cut.material(1, 0.5);
+                assert_eq!(arcs.len(), 1, "ae {ae}: {arcs:?}");
+                assert!((arcs[0].0 - (1.0 - ae / r).asin()).abs() < 1e-9, "ae {ae}: {arcs:?}");
+                assert!((arcs[0].1 - FRAC_PI_2).abs() < 1e-9, "ae {ae}: {arcs:?}");
+            }
         }
     }
 

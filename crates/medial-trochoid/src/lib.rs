@@ -5,7 +5,9 @@
 //! `camkit::contour::pocket`, simulates the material removal to get the exact engagement along
 //! them ([`engagement`]), finds where passes over the threshold meet the medial axis
 //! ([`medial`]), clears those stretches first with constant-radius trochoids ([`trochoid`]),
-//! re-simulates the whole program and estimates both programs' times ([`feed`]).
+//! re-simulates the whole program and estimates both programs' times ([`feed`]). Material the
+//! re-simulation still finds over the threshold makes the medial points within R of it
+//! dangerous too (the plan made again, a few rounds); what no loop can clear is named.
 
 pub mod angles;
 pub mod corner;
@@ -114,6 +116,17 @@ pub struct Plan {
     pub rests: Vec<corner::Rest>,
     /// Links of the trochoids-first program that went over the threshold, replaced.
     pub relinks: Vec<relink::Relink>,
+    /// Rounds of repair: the whole-program check found material over the threshold and
+    /// the medial points within R of it were made dangerous too (the plan made again).
+    pub repair_rounds: usize,
+    /// Points of material over the threshold that the repairs were made for.
+    pub repair_points: usize,
+    /// True if samples are left over because the repair rounds ran out (else, if any are,
+    /// because no loop fits within R of their material).
+    pub repairs_exhausted: bool,
+    /// Samples of cutting moves still over the threshold after the repairs: where the tool
+    /// centre is (mm) and the engagement (degrees). Empty when the threshold holds.
+    pub left_over: Vec<(P2, f64)>,
 }
 
 /// Round-off of a computed engagement (degrees): a side cut at exactly the threshold's step
@@ -318,6 +331,98 @@ pub fn plan(regions: &[Region], s: &Settings) -> Result<Plan, PlanError> {
     if pitches[0].is_none() {
         return Err(PlanError::NoPitch);
     }
+    let loops = Loops { radii, pitches };
+    // Material found over the threshold by the re-simulation: medial points within R of it
+    // are dangerous too (a loop centred there sweeps it away).
+    let mut repair_points: Vec<P2> = Vec::new();
+    let mut stretches = dangerous(regions, &medial, &loops, s, |p| grid.any_within(p, reach));
+    let mut built = build(regions, &pocket.passes, &stretches.runs, s, None);
+    let mut repair_rounds = 0;
+    let mut repairs_exhausted = true;
+    for _ in 0..REPAIR_ROUNDS {
+        let found = over_material(&built.trochoidal, s);
+        if found.is_empty() {
+            repairs_exhausted = false;
+            break;
+        }
+        repair_points.extend(found);
+        let near = PointGrid::new(&repair_points, s.radius);
+        let more =
+            dangerous(regions, &medial, &loops, s, |p| grid.any_within(p, reach) || near.any_within(p, s.radius));
+        // The runs made before are kept, in their order, and the new ones cut after them: the
+        // loops before are the same moves, so their engagement is not simulated again (a run
+        // that grew is cut again whole, the part cut before now in cleared ground).
+        let added: Vec<Run> = more.runs.into_iter().filter(|r| !stretches.runs.contains(r)).collect();
+        if added.is_empty() {
+            repairs_exhausted = false;
+            break;
+        }
+        let kept = stretches.runs.len();
+        stretches.runs.extend(added);
+        stretches.danger = more.danger;
+        stretches.uncleared = more.uncleared;
+        built = build(regions, &pocket.passes, &stretches.runs, s, Some((&built.trochoidal, kept)));
+        repair_rounds += 1;
+    }
+    let left_over = built
+        .trochoidal
+        .samples
+        .iter()
+        .zip(&built.trochoidal.engagement)
+        .filter(|((i, _), e)| {
+            matches!(built.trochoidal.program.moves[*i].tag, Tag::Trochoid | Tag::Contour)
+                && **e > s.threshold + ENGAGEMENT_ROUNDOFF_DEG
+        })
+        .map(|(&(i, t), &e)| (built.trochoidal.program.moves[i].seg.point_at(t), e))
+        .collect::<Vec<_>>();
+    let repairs_exhausted = repairs_exhausted && !left_over.is_empty();
+    Ok(Plan {
+        regions: regions.to_vec(),
+        passes: built.passes,
+        medial,
+        offset_only,
+        trochoidal: built.trochoidal,
+        danger: stretches.danger,
+        runs: stretches.runs,
+        uncleared: stretches.uncleared,
+        danger_samples: hot.len(),
+        rests: built.rests,
+        relinks: built.relinks,
+        repair_rounds,
+        repair_points: repair_points.len(),
+        repairs_exhausted,
+        left_over,
+    })
+}
+
+/// Most rounds of repair after the whole-program check (each takes a re-simulation).
+const REPAIR_ROUNDS: usize = 4;
+
+/// Loop radii tried (mm, the given one first, shrinking by [`LEVEL_RATIO`]) and the pitch
+/// that holds the threshold for each (`None`: none does).
+struct Loops {
+    radii: Vec<f64>,
+    pitches: Vec<Option<f64>>,
+}
+
+/// The medial axis's dangerous stretches (the points `hot` flags), the runs of loops along
+/// them and the stretches where no loop fits.
+struct Stretches {
+    danger: Vec<Vec<P2>>,
+    runs: Vec<Run>,
+    uncleared: Vec<Vec<P2>>,
+}
+
+/// The stretches of `medial` whose points `hot` flags, with the loops that fit there.
+fn dangerous(
+    regions: &[Region],
+    medial: &[Medial],
+    loops: &Loops,
+    s: &Settings,
+    hot: impl Fn(&P2) -> bool,
+) -> Stretches {
+    let wall = s.radius + s.allowance;
+    let (radii, pitches) = (&loops.radii, &loops.pitches);
     let mut danger = Vec::new();
     let mut runs: Vec<Run> = Vec::new();
     let mut uncleared = Vec::new();
@@ -328,7 +433,7 @@ pub fn plan(regions: &[Region], s: &Settings) -> Result<Plan, PlanError> {
             let flags: Vec<(bool, Option<(f64, f64)>)> = pts
                 .iter()
                 .map(|p| {
-                    let hot = grid.any_within(p, reach);
+                    let hot = hot(p);
                     // A loop's centre keeps its radius plus a pitch (the chord between centres
                     // cuts bends of the axis) from the walls. The radius is the largest that
                     // fits, at the pitch of the largest level that fits (a loop larger than its
@@ -353,11 +458,32 @@ pub fn plan(regions: &[Region], s: &Settings) -> Result<Plan, PlanError> {
             }
         }
     }
+    Stretches { danger, runs, uncleared }
+}
+
+/// A trochoids-first program and what making it decided.
+struct Built {
+    passes: Vec<Pass>,
+    rests: Vec<corner::Rest>,
+    trochoidal: Analysed,
+    relinks: Vec<relink::Relink>,
+}
+
+/// The trochoids-first program: `runs` first, then the pocket's `passes` (the wall passes'
+/// corners fitted), re-simulated, links over the threshold replaced. With `before` (a program
+/// whose runs were the first `k` of `runs`), the engagement along those runs' moves is taken
+/// from it.
+fn build(regions: &[Region], passes: &[Pass], runs: &[Run], s: &Settings, before: Option<(&Analysed, usize)>) -> Built {
+    let wall = s.radius + s.allowance;
     let mut troch = Program::default();
-    for run in &runs {
+    let mut same = 0;
+    for (k, run) in runs.iter().enumerate() {
+        if before.is_some_and(|(_, kept)| k == kept) {
+            same = troch.moves.len();
+        }
         trochoid::push_varying(&mut troch, &run.points, &run.radii, &run.pitches);
     }
-    let (passes, rests) = round_walls(&pocket.passes, &troch, s);
+    let (passes, rests) = round_walls(passes, &troch, s);
     let mut first = true;
     for (ri, region) in regions.iter().enumerate() {
         let mine: Vec<Pass> = passes.iter().filter(|p| p.region == ri).cloned().collect();
@@ -374,7 +500,10 @@ pub fn plan(regions: &[Region], s: &Settings) -> Result<Plan, PlanError> {
         }
         first = false;
     }
-    let mut trochoidal = analyse(troch, s, regions);
+    let mut trochoidal = match before {
+        Some((a, _)) => analyse_after(troch, s, regions, a, same),
+        None => analyse(troch, s, regions),
+    };
     // Links over the threshold: their passes started on cleared ground instead (one link a
     // round, re-simulated each time; a second round on the same link makes it a retract).
     let mut relinks = Vec::new();
@@ -396,19 +525,41 @@ pub fn plan(regions: &[Region], s: &Settings) -> Result<Plan, PlanError> {
         // The moves before the link are the same: their engagement is reused.
         trochoidal = analyse_after(p, s, regions, &trochoidal, i);
     }
-    Ok(Plan {
-        regions: regions.to_vec(),
-        passes,
-        medial,
-        offset_only,
-        trochoidal,
-        danger,
-        runs,
-        uncleared,
-        danger_samples: hot.len(),
-        rests,
-        relinks,
-    })
+    Built { passes, rests, trochoidal, relinks }
+}
+
+/// Points of the material met over the threshold by cutting moves (trochoids and passes) of
+/// `a`: along each arc of the tool circle in material at each such sample, at most `s.sample`
+/// mm apart, ends included.
+fn over_material(a: &Analysed, s: &Settings) -> Vec<P2> {
+    let limit = s.threshold + ENGAGEMENT_ROUNDOFF_DEG;
+    let over: Vec<(usize, f64)> = a
+        .samples
+        .iter()
+        .zip(&a.engagement)
+        .filter(|((i, _), e)| matches!(a.program.moves[*i].tag, Tag::Trochoid | Tag::Contour) && **e > limit)
+        .map(|(&it, _)| it)
+        .collect();
+    if over.is_empty() {
+        return Vec::new();
+    }
+    let cut = Cut::new(s.radius, a.program.moves.iter().map(|m| m.seg).collect());
+    let r = s.radius;
+    over.iter()
+        .flat_map(|&(i, t)| {
+            let p = a.program.moves[i].seg.point_at(t);
+            cut.material(i, t)
+                .into_iter()
+                .flat_map(move |(a0, a1)| {
+                    let n = ((a1 - a0) * r / s.sample).ceil().max(1.0) as usize;
+                    (0..=n).map(move |k| {
+                        let th = a0 + (a1 - a0) * k as f64 / n as f64;
+                        P2::new(p.x + r * th.cos(), p.y + r * th.sin())
+                    })
+                })
+                .collect::<Vec<_>>()
+        })
+        .collect()
 }
 
 /// Corner radii (mm) tried, smallest first, when the wall passes' corners are fitted by

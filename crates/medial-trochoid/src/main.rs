@@ -236,6 +236,16 @@ fn run(args: Args) -> Result<()> {
             rt * medial_trochoid::SMALLEST_LOOP
         ));
     }
+    if !plan.left_over.is_empty() {
+        let (p, e) = plan.left_over.iter().fold(plan.left_over[0], |w, x| if x.1 > w.1 { *x } else { w });
+        cli::warn(&format!(
+            "{} samples still over the threshold after {} repair rounds (the worst {e:.3}° at ({:.3}, {:.3})): listed in the report",
+            plan.left_over.len(),
+            plan.repair_rounds,
+            p.x,
+            p.y
+        ));
+    }
     let mut out = Output::new(args.io.output.as_deref());
     table::write(&mut out, &out_table, &WriteOptions { decimals: args.decimals })?;
     let title = |a: &Analysed, what: &str| {
@@ -292,6 +302,23 @@ fn run(args: Args) -> Result<()> {
             .set("offset_only_samples_over_threshold", a.over)
             .set("samples_over_threshold", b.over)
             .set("link_samples_over_threshold", b.over_links)
+            .set("repair_rounds", plan.repair_rounds)
+            .set("repair_material_points", plan.repair_points)
+            .set("over_threshold_at", plan.left_over.iter().map(|(p, e)| vec![p.x, p.y, *e]).collect::<Vec<_>>())
+            .set(
+                "over_threshold_reason",
+                (!plan.left_over.is_empty()).then(|| {
+                    format!(
+                        "still over after {} repair rounds: {}",
+                        plan.repair_rounds,
+                        if plan.repairs_exhausted {
+                            "the rounds ran out"
+                        } else {
+                            "no trochoid loop fits within R of the material met there"
+                        }
+                    )
+                }),
+            )
             .set("relinked", plan.relinks.len())
             .set("relinked_by_retract", plan.relinks.iter().filter(|l| l.retract).count())
             .set("relink_standing_engagement_deg", plan.relinks.iter().map(|l| l.standing_deg).collect::<Vec<_>>())
