@@ -339,7 +339,11 @@ pub fn plan(regions: &[Region], s: &Settings) -> Result<Plan, PlanError> {
     let mut built = build(regions, &pocket.passes, &stretches.runs, s, None);
     let mut repair_rounds = 0;
     let mut repairs_exhausted = true;
-    for _ in 0..REPAIR_ROUNDS {
+    // The plan returned is the best of the rounds (fewest samples over, then the lowest
+    // largest engagement): a round's new loops could make things worse elsewhere.
+    let score = |b: &Built| (b.trochoidal.over, b.trochoidal.max_cutting);
+    let mut best: Option<(Built, Stretches, usize)> = None;
+    for round in 1..=REPAIR_ROUNDS {
         let found = over_material(&built.trochoidal, s);
         if found.is_empty() {
             repairs_exhausted = false;
@@ -358,11 +362,23 @@ pub fn plan(regions: &[Region], s: &Settings) -> Result<Plan, PlanError> {
             break;
         }
         let kept = stretches.runs.len();
-        stretches.runs.extend(added);
-        stretches.danger = more.danger;
-        stretches.uncleared = more.uncleared;
-        built = build(regions, &pocket.passes, &stretches.runs, s, Some((&built.trochoidal, kept)));
-        repair_rounds += 1;
+        let next = Stretches {
+            runs: stretches.runs.iter().cloned().chain(added).collect(),
+            danger: more.danger,
+            uncleared: more.uncleared,
+        };
+        let again = build(regions, &pocket.passes, &next.runs, s, Some((&built.trochoidal, kept)));
+        let before = std::mem::replace(&mut built, again);
+        let previous = std::mem::replace(&mut stretches, next);
+        if best.as_ref().is_none_or(|b| score(&before) < score(&b.0)) {
+            best = Some((before, previous, repair_rounds));
+        }
+        repair_rounds = round;
+    }
+    if let Some((b, st, rounds)) = best
+        && score(&b) < score(&built)
+    {
+        (built, stretches, repair_rounds) = (b, st, rounds);
     }
     let left_over = built
         .trochoidal
