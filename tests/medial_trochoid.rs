@@ -336,9 +336,10 @@ fn material_over_the_threshold_after_the_plan_is_cleared_by_a_repair() {
 
 #[test]
 fn material_no_loop_can_clear_is_named_when_the_threshold_is_not_held() {
-    // A 12-gon of radius 15 (R5): after each 30° turn the wall pass meets the next side's
-    // band deeper than a step (42.4° or more), in corners too narrow for any loop, and no
-    // corner radius of the fit holds. The plan is returned, but it says so: every sample
+    // A 12-gon of radius 15 (R5): entering its 30° corners the wall pass meets the corner's
+    // material ahead (up to 48.2°), more than R from the last loop that fits on the spoke
+    // (the medial points within R of it are too near the walls for the smallest loop), and
+    // no corner radius of the fit holds. The plan is returned, but it says so: every sample
     // over the threshold is listed with where it is and why, and a warning is printed.
     let w = Work::new();
     let src = data("medial-trochoid/polygon12.csv");
