@@ -125,8 +125,11 @@ fn wall_pass_corners_are_rounded_and_their_rest_named() {
     let w = Work::new();
     let src = data("medial-trochoid/square.csv");
     let sq = src.to_str().unwrap();
-    // Sharp corners: the wall pass meets the corner's whole quadrant (≥ 90°).
-    w.run(BIN, &[sq, "--radius", "5", "--corner-radius", "0", "--report", "s.json", "-o", "s.csv"], b"").ok();
+    // Sharp corners: the wall pass meets the corner's whole quadrant (≥ 90°), a failed check
+    // unless the program is asked for anyway.
+    let sharp = [sq, "--radius", "5", "--corner-radius", "0", "--report", "s.json", "-o", "s.csv"];
+    assert_eq!(w.run(BIN, &sharp, b"").status, 1);
+    w.run(BIN, &[&sharp[..], &["--allow-over-threshold"]].concat(), b"").ok();
     let s = report(&w, "s.json");
     assert!(s["largest_engagement_deg"].as_f64().unwrap() >= 90.0, "{s}");
     assert_eq!(s["corner_rests"], 0);
@@ -344,8 +347,14 @@ fn material_no_loop_can_clear_is_named_when_the_threshold_is_not_held() {
     let w = Work::new();
     let src = data("medial-trochoid/polygon12.csv");
     let args = [src.to_str().unwrap(), "--radius", "5", "--report", "r.json", "-o", "t.csv"];
-    // (Today's limit, documented: a remedy for these corners makes this pocket hold.)
-    let run = w.run(BIN, &args, b"");
+    // (Today's limit, documented: a remedy for these corners makes this pocket hold.) A failed
+    // check: the report names the places, the program is not written, exit status 1.
+    let refused = w.run(BIN, &args, b"");
+    assert_eq!(refused.status, 1, "{}", refused.stderr);
+    assert!(refused.stderr.contains("--allow-over-threshold"), "{}", refused.stderr);
+    assert!(!w.path("t.csv").exists());
+    assert_eq!(report(&w, "r.json")["threshold_held"], false);
+    let run = w.run(BIN, &[&args[..], &["--allow-over-threshold"]].concat(), b"");
     run.ok();
     let r = report(&w, "r.json");
     let over = r["samples_over_threshold"].as_u64().unwrap();

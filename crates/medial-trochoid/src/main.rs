@@ -79,6 +79,11 @@ struct Args {
     /// Which program to write.
     #[arg(long, value_enum, default_value_t = Which::Trochoid)]
     program: Which,
+    /// Write the trochoids-first program even where its re-simulation goes over the threshold
+    /// (a warning; the places are listed in the report). Without it that is a failed check:
+    /// the report and plots are written, the program is not, exit status 1.
+    #[arg(long)]
+    allow_over_threshold: bool,
     /// Snap grid of the Voronoi input (mm).
     #[arg(long, default_value_t = 1e-6, value_name = "MM")]
     resolution: f64,
@@ -236,15 +241,21 @@ fn run(args: Args) -> Result<()> {
             rt * medial_trochoid::SMALLEST_LOOP
         ));
     }
-    if !plan.left_over.is_empty() {
+    // The trochoids-first program's own check: over the threshold is a failed check unless the
+    // user asked for the program anyway.
+    let over = (!plan.left_over.is_empty()).then(|| {
         let (p, e) = plan.left_over.iter().fold(plan.left_over[0], |w, x| if x.1 > w.1 { *x } else { w });
-        cli::warn(&format!(
+        format!(
             "{} samples still over the threshold after {} repair rounds (the worst {e:.3}° at ({:.3}, {:.3})): listed in the report",
             plan.left_over.len(),
             plan.repair_rounds,
             p.x,
             p.y
-        ));
+        )
+    });
+    let failed = over.as_ref().filter(|_| args.program == Which::Trochoid && !args.allow_over_threshold);
+    if let Some(over) = over.as_ref().filter(|_| failed.is_none()) {
+        cli::warn(over);
     }
     let mut out = Output::new(args.io.output.as_deref());
     table::write(&mut out, &out_table, &WriteOptions { decimals: args.decimals })?;
@@ -357,6 +368,11 @@ fn run(args: Args) -> Result<()> {
             .set("output_rows", out_table.rows.len())
             .set("seconds", started.elapsed().as_secs_f64());
         rep.write(path)?;
+    }
+    if let Some(over) = failed {
+        return Err(Error::check(format!(
+            "the trochoids-first program is not written: {over}; --allow-over-threshold writes it anyway"
+        )));
     }
     out.commit()
 }
