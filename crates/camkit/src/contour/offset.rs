@@ -5,7 +5,7 @@
 
 use super::Contour;
 use super::region::Region;
-use super::verify::{Check, Defect, SegSet, verify, verify_within};
+use super::verify::{Check, Defect, SegSet, verify};
 use crate::tol;
 use cavalier_contours::polyline::{PlineOffsetOptions, PlineSource, Polyline, TouchingLoopBehavior};
 use cavalier_contours::shape_algorithms::{Shape, ShapeOffsetOptions};
@@ -175,7 +175,7 @@ const COVER_BUDGET: usize = 1024;
 /// of a pocket, share them). With `inward`, the region inside `input` is first tried for a
 /// cheap proof that it has no point `d − tol` from its loops ([`proved_empty`]): then no result
 /// but none can verify, and none is verified and returned without a kernel run.
-/// Completeness is asked only inside `scope` (see [`verify_within`]; none: everywhere).
+/// Completeness is asked only inside `scope` (see [`verify`]; none: everywhere).
 #[allow(clippy::too_many_arguments)]
 fn verified_from(
     set: &SegSet,
@@ -191,7 +191,7 @@ fn verified_from(
 ) -> Result<Offset, OffsetError> {
     if inward
         && proved_empty(set, d, opts)
-        && let Ok(check) = verify(set, &[], d, side, closed, opts.tol, opts.self_crossing_input)
+        && let Ok(check) = verify(set, &[], d, side, closed, opts.tol, opts.self_crossing_input, &[])
     {
         return Ok(Offset { contours: Vec::new(), check, attempts: 0, cleaned: false });
     }
@@ -223,7 +223,7 @@ fn verified_from(
             // A loop no longer than the tolerance is round-off where two loops touch (the lens
             // between two tangent circles): the tool would cut nothing there.
             out.retain(|c| longer_than(c, opts.tol));
-            match verify_within(set, &out, d, side, closed, opts.tol, opts.self_crossing_input, scope) {
+            match verify(set, &out, d, side, closed, opts.tol, opts.self_crossing_input, scope) {
                 Ok(check) => return Ok(Offset { contours: out, check, attempts, cleaned: was_cleaned }),
                 Err(e) => defect = Some(e),
             }
@@ -374,7 +374,7 @@ pub fn check_offset(
     closed: bool,
     tol: f64,
 ) -> Result<Check, Defect> {
-    verify(&SegSet::new(input.iter().copied()), output, d, side.sign(), closed, tol, false)
+    verify(&SegSet::new(input.iter().copied()), output, d, side.sign(), closed, tol, false, &[])
 }
 
 /// True if `loops` (oriented as a region) still have something left after an inward offset by

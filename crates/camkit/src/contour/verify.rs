@@ -793,30 +793,18 @@ fn check_piece(
     Err(Defect::Stray(mid, best))
 }
 
-/// Verifies that `output` is the offset of `input` by `d` (mm, > 0) to `side` (+1 left, −1
-/// right of each input piece) within `tol`; `closed` requires every output loop to be closed.
-/// `crossing_input` lets output loops cross (the offset of a self-crossing input crosses too).
-pub(crate) fn verify(
-    input: &SegSet,
-    output: &[Contour],
-    d: f64,
-    side: f64,
-    closed: bool,
-    tol: f64,
-    crossing_input: bool,
-) -> Result<Check, Defect> {
-    verify_within(input, output, d, side, closed, tol, crossing_input, &[])
-}
-
 /// How far, in tolerances, along an input piece the completeness probe looks on either side for
 /// valid offset points before it counts a lone valid one as a point the offset shrank to.
 const ISOLATED: f64 = 2.0;
 
-/// [`verify`] of the part of the offset that lies inside `scope` (loops oriented as a region;
-/// none: all of it): a valid offset point outside `scope` need not lie on `output`. The clean-up
-/// pass of one piece of a pocket level is the offset of the region inside that piece only.
+/// Verifies that `output` is the offset of `input` by `d` (mm, > 0) to `side` (+1 left, −1
+/// right of each input piece) within `tol`; `closed` requires every output loop to be closed.
+/// `crossing_input` lets output loops cross (the offset of a self-crossing input crosses too).
+/// Only the part of the offset inside `scope` (loops oriented as a region; none: all of it) must
+/// be on `output`: the clean-up pass of one piece of a pocket level is the offset of the region
+/// inside that piece only.
 #[allow(clippy::too_many_arguments)]
-pub(crate) fn verify_within(
+pub(crate) fn verify(
     input: &SegSet,
     output: &[Contour],
     d: f64,
@@ -829,7 +817,7 @@ pub(crate) fn verify_within(
     verify_with(input, output, &Spec { d, side, tol, shortcuts: true }, closed, crossing_input, scope)
 }
 
-/// [`verify_within`] with its settings spelled out.
+/// [`verify`] with its settings spelled out.
 fn verify_with(
     input: &SegSet,
     output: &[Contour],
@@ -1027,10 +1015,10 @@ mod tests {
         let (c, d) = (gon(50.0), 45.0);
         let out = [gon(50.0 - d / (std::f64::consts::PI / n as f64).cos())];
         let input = SegSet::new([&c]);
-        let check = verify(&input, &out, d, 1.0, true, 1e-6, false).unwrap();
+        let check = verify(&input, &out, d, 1.0, true, 1e-6, false, &[]).unwrap();
         assert!(check.deviation() < 1e-9, "{check:?}");
         for (d, want) in [(d - 1e-5, "stray"), (d + 1e-5, "gouge")] {
-            match (verify(&input, &out, d, 1.0, true, 1e-6, false), want) {
+            match (verify(&input, &out, d, 1.0, true, 1e-6, false, &[]), want) {
                 (Err(Defect::Stray(..)), "stray") | (Err(Defect::Gouge(..)), "gouge") => {}
                 (r, _) => panic!("{want}: {r:?}"),
             }
