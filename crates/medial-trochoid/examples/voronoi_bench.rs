@@ -1,12 +1,13 @@
 //! Times the medial axis (boostvoronoi) of a wavy star pocket with N segments and writes the
-//! segments it used (integer, 1e-6 mm grid) so that scripts/bench-trochoid.sh can give the same
-//! input to Boost.Voronoi (pyvoronoi), and the ends of the kept medial edges in the same integer
-//! frame to SEGMENTS_FILE.ends. Usage: voronoi_bench N SEGMENTS_FILE.
+//! segments it used (`builder_input`: integer, in the medial axis's own frame, grid RESOLUTION mm,
+//! default the library's 1e-6) so that scripts/bench-trochoid.sh can give the same input to
+//! Boost.Voronoi (pyvoronoi), and the ends of the kept medial edges in the same integer frame to
+//! SEGMENTS_FILE.ends. Usage: voronoi_bench N SEGMENTS_FILE [RESOLUTION].
 
 use camkit::contour::Contour;
 use camkit::contour::region::regions;
 use camkit::geom::P2;
-use medial_trochoid::medial::{MedialOptions, medial_axis};
+use medial_trochoid::medial::{MedialOptions, builder_input, medial_axis};
 use std::io::Write;
 use std::time::Instant;
 
@@ -23,7 +24,10 @@ fn main() {
         })
         .collect();
     let region = regions(&[Contour::polygon(&pts, true)]).expect("a simple star").0.remove(0);
-    let opts = MedialOptions::default();
+    let mut opts = MedialOptions::default();
+    if let Some(r) = args.get(3) {
+        opts.resolution = r.parse().expect("RESOLUTION in mm");
+    }
     let (mut times, mut builds) = (Vec::new(), Vec::new());
     let mut edges = 0;
     let mut ends: Vec<P2> = Vec::new();
@@ -37,21 +41,21 @@ fn main() {
     }
     times.sort_by(f64::total_cmp);
     builds.sort_by(f64::total_cmp);
+    let (frame, segments) = builder_input(&region, &opts).expect("snapped boundary");
     let mut f = std::fs::File::create(&file).expect("segments file");
-    let (lo, hi) = region.outer.bounds().expect("bounds");
-    let o = P2::new(0.5 * (lo.x + hi.x), 0.5 * (lo.y + hi.y));
-    for k in 0..n {
-        let (a, b) = (pts[k], pts[(k + 1) % n]);
-        let s = |v: f64, c: f64| ((v - c) / opts.resolution).round() as i64;
-        writeln!(f, "{} {} {} {}", s(a.x, o.x), s(a.y, o.y), s(b.x, o.x), s(b.y, o.y)).expect("write");
+    for [ax, ay, bx, by] in segments {
+        writeln!(f, "{ax} {ay} {bx} {by}").expect("write");
     }
     let mut g = std::fs::File::create(format!("{file}.ends")).expect("ends file");
     for p in &ends {
-        writeln!(g, "{} {}", (p.x - o.x) / opts.resolution, (p.y - o.y) / opts.resolution).expect("write");
+        let (x, y) = frame.to_grid(p);
+        writeln!(g, "{x} {y}").expect("write");
     }
     println!(
-        "segments {n} medial_edges {edges} median_ms {:.3} (voronoi build alone {:.3})",
+        "segments {n} medial_edges {edges} best_ms {:.3} median_ms {:.3} (voronoi build alone: best {:.3} median {:.3})",
+        times[0] * 1e3,
         times[3] * 1e3,
+        builds[0] * 1e3,
         builds[3] * 1e3
     );
 }
