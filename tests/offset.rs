@@ -473,7 +473,14 @@ fn bad_input_is_refused_with_one_line_and_no_output_file() {
     w.write("text.csv", format!("{HEAD}0,rapid,0,0,,\n0,line,1O,0,,\n"));
     w.write("nox.csv", "path,move,y\n0,line,1\n");
     w.write("empty.csv", "");
+    // An island (path 7) touching the outer loop at a vertex: named by its path id.
+    let touching = format!(
+        "{HEAD}0,rapid,0,0,,\n0,line,10,0,,\n0,line,10,10,,\n0,line,0,10,,\n0,line,0,0,,\n\
+         7,rapid,10,5,,\n7,line,5,3,,\n7,line,5,7,,\n7,line,10,5,,\n"
+    );
+    w.write("touching.csv", &touching);
     let cases: &[(&[&str], &str)] = &[
+        (&["touching.csv", "--radius", "1", "--repeat", "1"], "crosses or touches path 7 at (10.000000, 5.000000)"),
         (&["bow.csv", "--radius", "1", "--side", "left"], "bow.csv:2"),
         (&["bow.csv", "--radius", "1", "--side", "left"], "crosses itself at (10.000000, 5.000000)"),
         (&["open.csv", "--radius", "1", "--repeat", "2"], "open.csv:4"),

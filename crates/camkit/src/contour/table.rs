@@ -147,12 +147,13 @@ pub fn pocket_regions(sources: &[Source], name: &str) -> Result<(Vec<Region>, us
     }
     let loops: Vec<Contour> = sources.iter().map(|s| s.contour.clone()).collect();
     region::regions(&loops).map_err(|e| {
-        let i = match e {
-            RegionError::Open(i)
-            | RegionError::Degenerate(i)
-            | RegionError::SelfCrossing(i, _)
-            | RegionError::Crossing(i, _, _) => i,
+        let (i, message) = match e {
+            RegionError::Open(i) | RegionError::Degenerate(i) | RegionError::SelfCrossing(i, _) => (i, e.to_string()),
+            // Name the other contour by its path id, as the user wrote it, not by its index.
+            RegionError::Crossing(i, j, p) => {
+                (i, format!("the contour crosses or touches path {} at ({:.6}, {:.6})", sources[j].path, p.x, p.y))
+            }
         };
-        Error::input(format!("path {}: {e}", sources[i].path)).at(Location::file(name).line(sources[i].line))
+        Error::input(format!("path {}: {message}", sources[i].path)).at(Location::file(name).line(sources[i].line))
     })
 }
