@@ -338,29 +338,21 @@ pub(crate) fn offset_region_in(
     })
 }
 
-/// Offsets `loops` (a region already offset from `input`'s loops, oriented as a region) inward by
-/// `rel` more, verified against `input` at the total distance `total` as the part of that offset
-/// inside `loops` (one piece of a pocket level need not hold the other pieces' offsets).
-pub fn offset_region_further(
+/// Offsets `loops` (a region already offset from `region`'s loops, oriented as a region) inward
+/// by `rel` more, verified against `region` (its pieces made once: `pieces`) at the total distance
+/// `total` as the part of that offset inside `loops` (one piece of a pocket level need not hold
+/// the other pieces' offsets).
+pub(crate) fn offset_region_further(
     loops: &[&Contour],
     rel: f64,
-    input: &Region,
+    region: &Region,
+    pieces: &RegionPieces,
     total: f64,
     opts: &OffsetOptions,
 ) -> Result<Offset, OffsetError> {
-    let input = input.loops();
-    verified_from(
-        &SegSet::new(input.iter().copied()),
-        loops,
-        &input,
-        total,
-        1.0,
-        true,
-        opts,
-        false,
-        loops,
-        |source, nudge, eps, _| shape_offset(source, rel + nudge, eps),
-    )
+    verified_from(&pieces.0, loops, &region.loops(), total, 1.0, true, opts, false, loops, |source, nudge, eps, _| {
+        shape_offset(source, rel + nudge, eps)
+    })
 }
 
 /// Verifies offsets made elsewhere (another kernel, another run) by the check every result of

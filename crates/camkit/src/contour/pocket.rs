@@ -179,7 +179,7 @@ pub fn pocket(regions: &[Region], opts: &PocketOptions) -> Result<Pocket, Pocket
             previous = current;
         }
         if opts.passes == Passes::UntilEmpty && opts.step <= 2.0 * opts.radius {
-            add_clean_ups(&mut pieces, region, ri, opts, &mut result)?;
+            add_clean_ups(&mut pieces, region, &input, ri, opts, &mut result)?;
         }
         let roots: Vec<usize> = (0..pieces.len()).filter(|&i| pieces[i].level == 0).collect();
         emit(&pieces, &roots, ri, opts.direction, &mut cursor, &mut result.passes);
@@ -195,6 +195,7 @@ type CleanUp = (usize, f64, super::Offset);
 fn add_clean_ups(
     pieces: &mut [Piece],
     region: &Region,
+    input: &RegionPieces,
     ri: usize,
     opts: &PocketOptions,
     result: &mut Pocket,
@@ -221,7 +222,7 @@ fn add_clean_ups(
                 if region_survives(&loops, mid) { lo = mid } else { hi = mid }
             }
             let total = p.distance + lo;
-            offset_region_further(&loops, lo, region, total, &opts.offset)
+            offset_region_further(&loops, lo, region, input, total, &opts.offset)
                 .map(|o| (!o.contours.is_empty()).then_some((i, total, o)))
                 .map_err(|error| PocketError { region: ri, distance: total, error })
         })
