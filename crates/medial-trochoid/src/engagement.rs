@@ -219,17 +219,20 @@ impl Cut {
     /// Engagement (radians) at fraction `t` of piece `i`: the part of the tool circle not
     /// removed by pieces `0..i` and by piece `i` up to `t`.
     pub fn engagement(&self, i: usize, t: f64) -> f64 {
-        let p = self.pieces[i].point_at(t);
-        let own: Vec<Seg> = if t > 0.0 { vec![self.pieces[i].sub(0.0, t)] } else { Vec::new() };
-        self.free(&p, i, &own)
+        self.on_piece(i, t, |p, own| self.free(p, i, own))
     }
 
     /// The arcs of the tool circle in material at fraction `t` of piece `i` (what
     /// [`Cut::engagement`] measures), as angle intervals (radians, within [0, 2π)).
     pub fn material(&self, i: usize, t: f64) -> Vec<(f64, f64)> {
+        self.on_piece(i, t, |p, own| gaps(&self.removed(p, i, own)))
+    }
+
+    /// `f` of the tool centre at fraction `t` of piece `i` and what that piece has cut so far.
+    fn on_piece<R>(&self, i: usize, t: f64, f: impl FnOnce(&P2, &[Seg]) -> R) -> R {
         let p = self.pieces[i].point_at(t);
         let own: Vec<Seg> = if t > 0.0 { vec![self.pieces[i].sub(0.0, t)] } else { Vec::new() };
-        gaps(&self.removed(&p, i, &own))
+        f(&p, &own)
     }
 
     /// Engagement (radians) of a tool standing at `p` after pieces `0..before`: the part of its

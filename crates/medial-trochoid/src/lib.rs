@@ -215,13 +215,7 @@ pub fn analyse_after(
     }
     let get = |t: Tag| worst.get(&t).copied().unwrap_or(0.0);
     let max_cutting = get(Tag::Trochoid).max(get(Tag::Contour));
-    let over = samples
-        .iter()
-        .zip(&engagement)
-        .filter(|((i, _), e)| {
-            matches!(program.moves[*i].tag, Tag::Trochoid | Tag::Contour) && **e > s.threshold + ENGAGEMENT_ROUNDOFF_DEG
-        })
-        .count();
+    let over = cutting_over(&program, &samples, &engagement, s.threshold).count();
     let over_links = samples
         .iter()
         .zip(&engagement)
@@ -380,16 +374,9 @@ pub fn plan(regions: &[Region], s: &Settings) -> Result<Plan, PlanError> {
     {
         (built, stretches, repair_rounds) = (b, st, rounds);
     }
-    let left_over = built
-        .trochoidal
-        .samples
-        .iter()
-        .zip(&built.trochoidal.engagement)
-        .filter(|((i, _), e)| {
-            matches!(built.trochoidal.program.moves[*i].tag, Tag::Trochoid | Tag::Contour)
-                && **e > s.threshold + ENGAGEMENT_ROUNDOFF_DEG
-        })
-        .map(|(&(i, t), &e)| (built.trochoidal.program.moves[i].seg.point_at(t), e))
+    let b = &built.trochoidal;
+    let left_over = cutting_over(&b.program, &b.samples, &b.engagement, s.threshold)
+        .map(|((i, t), e)| (b.program.moves[i].seg.point_at(t), e))
         .collect::<Vec<_>>();
     let repairs_exhausted = repairs_exhausted && !left_over.is_empty();
     Ok(Plan {
@@ -544,18 +531,26 @@ fn build(regions: &[Region], passes: &[Pass], runs: &[Run], s: &Settings, before
     Built { passes, rests, trochoidal, relinks }
 }
 
+/// Samples (piece, fraction) of cutting moves (trochoids and passes) whose engagement is over
+/// `threshold` beyond round-off, with the engagement (degrees).
+fn cutting_over<'a>(
+    program: &'a Program,
+    samples: &'a [(usize, f64)],
+    engagement: &'a [f64],
+    threshold: f64,
+) -> impl Iterator<Item = ((usize, f64), f64)> + 'a {
+    samples.iter().zip(engagement).filter_map(move |(&(i, t), &e)| {
+        (matches!(program.moves[i].tag, Tag::Trochoid | Tag::Contour) && e > threshold + ENGAGEMENT_ROUNDOFF_DEG)
+            .then_some(((i, t), e))
+    })
+}
+
 /// Points of the material met over the threshold by cutting moves (trochoids and passes) of
 /// `a`: along each arc of the tool circle in material at each such sample, at most `s.sample`
 /// mm apart, ends included.
 fn over_material(a: &Analysed, s: &Settings) -> Vec<P2> {
-    let limit = s.threshold + ENGAGEMENT_ROUNDOFF_DEG;
-    let over: Vec<(usize, f64)> = a
-        .samples
-        .iter()
-        .zip(&a.engagement)
-        .filter(|((i, _), e)| matches!(a.program.moves[*i].tag, Tag::Trochoid | Tag::Contour) && **e > limit)
-        .map(|(&it, _)| it)
-        .collect();
+    let over: Vec<(usize, f64)> =
+        cutting_over(&a.program, &a.samples, &a.engagement, s.threshold).map(|(it, _)| it).collect();
     if over.is_empty() {
         return Vec::new();
     }
