@@ -9,6 +9,20 @@ fn report(w: &Work, name: &str) -> serde_json::Value {
     serde_json::from_str(&w.read(name)).expect("report is JSON")
 }
 
+/// The trochoids-first program of report `r` (and its rows in `csv`) holds the 40° threshold
+/// (to the named round-off; 3 decimals in the rows) with no gouge for tool radius `radius`.
+fn assert_holds(r: &serde_json::Value, csv: &str, radius: f64) {
+    let f = |k: &str| r[k].as_f64().unwrap_or_else(|| panic!("{k} in {r}"));
+    assert!(f("largest_engagement_deg") <= 40.0 + 1e-5, "{r}");
+    assert_eq!(r["samples_over_threshold"], 0);
+    assert_eq!(r["threshold_held"], true);
+    assert_eq!(r["no_gouge"], true);
+    assert!(f("smallest_wall_clearance_mm") >= radius - 1e-6, "{r}");
+    let out = rows(csv);
+    let worst = out.iter().filter(|(t, ..)| t == "trochoid" || t == "contour").filter_map(|r| r.1).fold(0.0, f64::max);
+    assert!(worst <= 40.0005, "{worst}");
+}
+
 /// Rows of the output table as (tag, engagement, x, y) with the header's column order.
 fn rows(csv: &str) -> Vec<(String, Option<f64>, f64, f64)> {
     let mut lines = csv.lines();
@@ -36,12 +50,9 @@ fn square_pocket_engagement_meets_closed_forms_and_trochoids_lower_it() {
     assert!(f("largest_engagement_deg") < f("offset_only_largest_engagement_deg"));
     // Trochoids first and the wall pass's corners rounded by simulation: the whole program's
     // passes and loops hold the threshold (to the named round-off), every corner fitted.
-    assert!(f("largest_engagement_deg") <= 40.0 + 1e-5, "{r}");
-    assert_eq!(r["samples_over_threshold"], 0);
-    assert_eq!(r["threshold_held"], true);
+    assert_holds(&r, &w.read("t.csv"), 5.0);
     assert_eq!(r["corners_unfitted"], 0);
     assert_eq!(r["corner_rests"], 4);
-    assert_eq!(r["no_gouge"], true);
     assert!((f("smallest_wall_clearance_mm") - 5.0).abs() < 1e-6);
     assert!(f("medial_equidistance_error_mm") < 1e-6);
     assert_eq!(r["medial_edges"], 5);
@@ -279,20 +290,13 @@ fn many_sided_pocket_holds_the_threshold_without_gouge() {
     let r = report(&w, "r.json");
     let f = |k: &str| r[k].as_f64().unwrap_or_else(|| panic!("{k} in {r}"));
     assert!(f("offset_only_largest_engagement_deg") > 40.0 + 1e-5);
-    assert!(f("largest_engagement_deg") <= 40.0 + 1e-5, "{r}");
-    assert_eq!(r["samples_over_threshold"], 0);
+    assert_holds(&r, &w.read("t.csv"), 2.5);
     assert_eq!(r["link_samples_over_threshold"], 0);
-    assert_eq!(r["threshold_held"], true);
-    assert_eq!(r["no_gouge"], true);
-    assert!(f("smallest_wall_clearance_mm") >= 2.5 - 1e-6);
     // Shallow turns that hold the threshold sharp are kept sharp: no rest for them.
     assert!(r["corner_rests"].as_u64().unwrap() < 32, "{r}");
     assert_eq!(r["corners_unfitted"], 0);
     assert!(r["trochoid_runs"].as_u64().unwrap() >= 32, "a run on every spoke: {r}");
-    // The written rows agree with the report: no cutting row over the threshold (3 decimals).
     let out = rows(&w.read("t.csv"));
-    let worst = out.iter().filter(|(t, ..)| t == "trochoid" || t == "contour").filter_map(|r| r.1).fold(0.0, f64::max);
-    assert!(worst <= 40.0005, "{worst}");
     // Every row's tool centre is at least R from every side of the 32-gon (vertices to 1e-6).
     let v: Vec<(f64, f64)> = (0..32)
         .map(|k| {
@@ -323,18 +327,11 @@ fn material_over_the_threshold_after_the_plan_is_cleared_by_a_repair() {
     let args = [src.to_str().unwrap(), "--radius", "5", "--report", "r.json", "-o", "t.csv"];
     w.run(BIN, &args, b"").ok();
     let r = report(&w, "r.json");
-    let f = |k: &str| r[k].as_f64().unwrap_or_else(|| panic!("{k} in {r}"));
     assert!(r["repair_rounds"].as_u64().unwrap() >= 1, "{r}");
     assert!(r["repair_material_points"].as_u64().unwrap() >= 1, "{r}");
-    assert!(f("largest_engagement_deg") <= 40.0 + 1e-5, "{r}");
-    assert_eq!(r["samples_over_threshold"], 0);
-    assert_eq!(r["threshold_held"], true);
+    assert_holds(&r, &w.read("t.csv"), 5.0);
     assert_eq!(r["over_threshold_at"].as_array().map(Vec::len), Some(0), "{r}");
     assert!(r["over_threshold_reason"].is_null(), "{r}");
-    assert_eq!(r["no_gouge"], true);
-    let out = rows(&w.read("t.csv"));
-    let worst = out.iter().filter(|(t, ..)| t == "trochoid" || t == "contour").filter_map(|r| r.1).fold(0.0, f64::max);
-    assert!(worst <= 40.0005, "{worst}");
 }
 
 #[test]
