@@ -479,7 +479,16 @@ fn bad_input_is_refused_with_one_line_and_no_output_file() {
          7,rapid,10,5,,\n7,line,5,3,,\n7,line,5,7,,\n7,line,10,5,,\n"
     );
     w.write("touching.csv", &touching);
+    // Profiles that turn back (an undercut), named at the row of the piece: a line going back,
+    // and an arc whose ends run forward but whose middle passes a vertical tangent.
+    w.write("back.csv", format!("{HEAD}0,rapid,0,0,,\n0,line,10,0,,\n0,line,5,5,,\n0,line,20,5,,\n"));
+    w.write(
+        "bulge.csv",
+        format!("{HEAD}0,rapid,0,0,,\n0,line,10,0,,\n0,line,20,0,,\n0,ccw,22,8,21,4\n0,line,30,8,,\n"),
+    );
     let cases: &[(&[&str], &str)] = &[
+        (&["back.csv", "--radius", "1", "--profile", "ball", "--up", "y"], "back.csv:4: the profile turns back"),
+        (&["bulge.csv", "--radius", "1", "--profile", "square", "--up", "y"], "bulge.csv:5: the profile turns back"),
         (&["touching.csv", "--radius", "1", "--repeat", "1"], "crosses or touches path 7 at (10.000000, 5.000000)"),
         (&["bow.csv", "--radius", "1", "--side", "left"], "bow.csv:2"),
         (&["bow.csv", "--radius", "1", "--side", "left"], "crosses itself at (10.000000, 5.000000)"),

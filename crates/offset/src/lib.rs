@@ -221,11 +221,15 @@ pub fn profile_mode(
     for pass in table.passes() {
         let Some(p) = Profile::read(pass, name, up)? else { continue };
         let segs: Vec<Seg> = p.contour.segs().collect();
-        profile::check_monotone(&segs).map_err(|_| {
+        profile::check_monotone(&segs).map_err(|e| {
+            let piece = match e {
+                profile::ProfileError::NotMonotone(i) => Some(&segs[i]),
+                _ => None,
+            };
             Error::input(
                 "the profile turns back along its horizontal axis (an undercut): a tool from above cannot follow it",
             )
-            .at(located(name, pass[0].line))
+            .at(located(name, piece.and_then(|s| p.row_of(pass, s)).unwrap_or(pass[0].line)))
         })?;
         let tip = match tool {
             profile::Tool::Ball => profile::ball(&p.contour, r, opts),
@@ -349,6 +353,16 @@ impl Profile {
             contour = contour.reversed();
         }
         Ok(Some(Profile { contour, along, up: upi, depth, plane, flip }))
+    }
+
+    /// Source line of the row whose move makes `piece` (the row at one of its ends, the row
+    /// before at the other), for messages about that piece.
+    fn row_of(&self, pass: &[Row], piece: &Seg) -> Option<u64> {
+        let at = |r: &Row, q: &P2| (P2::new(r.pos[self.along], r.pos[self.up]) - q).norm() <= camkit::tol::POINT_EPS;
+        let (a, b) = (piece.start(), piece.end());
+        pass.windows(2)
+            .find(|w| (at(&w[0], &a) && at(&w[1], &b)) || (at(&w[0], &b) && at(&w[1], &a)))
+            .map(|w| w[1].line)
     }
 
     /// Rows of a 2D tip path back in the table's coordinates.
