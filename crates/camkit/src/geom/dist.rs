@@ -203,16 +203,40 @@ pub fn arc_arc_max(from: &Arc2, to: &Arc2) -> f64 {
 
 /// Smallest distance between the segments `[a, b]` and `[c, d]` (0 if they meet).
 pub fn segment_segment_min(a: &P2, b: &P2, c: &P2, d: &P2) -> f64 {
-    let (u, v, w) = (b - a, d - c, c - a);
-    let den = cross2(&u, &v);
-    if den != 0.0 {
-        let t = cross2(&w, &v) / den;
-        let s = cross2(&w, &u) / den;
-        if (0.0..=1.0).contains(&t) && (0.0..=1.0).contains(&s) {
-            return 0.0;
-        }
+    if segments_meet(a, b, c, d) {
+        return 0.0;
     }
     point_segment(a, c, d).min(point_segment(b, c, d)).min(point_segment(c, a, b)).min(point_segment(d, a, b))
+}
+
+/// True if the segments `[a, b]` and `[c, d]` share a point, decided exactly for the given
+/// coordinates by adaptive orientation predicates (Shewchuk's, the `robust` crate): for nearly
+/// parallel segments the floating crossing parameters are noise, which made two consecutive
+/// pieces of a straight run, a few nanometres apart, "meet".
+pub fn segments_meet(a: &P2, b: &P2, c: &P2, d: &P2) -> bool {
+    // Boxes apart (exact comparisons): the usual case, decided without the predicates.
+    if a.x.max(b.x) < c.x.min(d.x)
+        || c.x.max(d.x) < a.x.min(b.x)
+        || a.y.max(b.y) < c.y.min(d.y)
+        || c.y.max(d.y) < a.y.min(b.y)
+    {
+        return false;
+    }
+    let at = |p: &P2| robust::Coord { x: p.x, y: p.y };
+    let orient = |p: &P2, q: &P2, r: &P2| robust::orient2d(at(p), at(q), at(r));
+    let (d1, d2, d3, d4) = (orient(a, b, c), orient(a, b, d), orient(c, d, a), orient(c, d, b));
+    let apart = |x: f64, y: f64| (x > 0.0 && y < 0.0) || (x < 0.0 && y > 0.0);
+    if apart(d1, d2) && apart(d3, d4) {
+        return true;
+    }
+    // A point on the other segment's line meets it where it lies within that segment's box.
+    let within = |p: &P2, q: &P2, r: &P2| {
+        r.x >= p.x.min(q.x) && r.x <= p.x.max(q.x) && r.y >= p.y.min(q.y) && r.y <= p.y.max(q.y)
+    };
+    (d1 == 0.0 && within(a, b, c))
+        || (d2 == 0.0 && within(a, b, d))
+        || (d3 == 0.0 && within(c, d, a))
+        || (d4 == 0.0 && within(c, d, b))
 }
 
 /// Smallest distance between the segment `[a, b]` and `arc` (0 if they meet): crossings, the
@@ -293,6 +317,28 @@ mod tests {
 
     fn quarter() -> Arc2 {
         Arc2::from_centre(P2::origin(), &P2::new(1.0, 0.0), &P2::new(0.0, 1.0), true, false)
+    }
+
+    #[test]
+    fn consecutive_pieces_of_a_straight_run_do_not_meet() {
+        // Two pieces of a nearly straight run (joints printed to 1e-9 mm, so a kink of a few
+        // nanoradians), each cut 1e-9 mm short of their joint, as the self-crossing test of a
+        // contour measures them: 2e-9 mm apart. The floating crossing parameters said 0.
+        let p = |x: f64, y: f64| P2::new(x, y);
+        let (a, b, c) = (p(26.74897854, 46.120090744), p(25.689794481, 44.730928318), p(24.630610432, 43.341765886));
+        let (k1, k2) = (1e-9 / (b - a).norm(), 1e-9 / (c - b).norm());
+        let (s0, s1) = (a + (b - a) * k1, a + (b - a) * (1.0 - k1));
+        let (t0, t1) = (b + (c - b) * k2, b + (c - b) * (1.0 - k2));
+        let m = segment_segment_min(&s0, &s1, &t0, &t1);
+        assert!((m - 2e-9).abs() < 1e-12, "{m:e}");
+        assert!(!segments_meet(&s0, &s1, &t0, &t1));
+        // Collinear: overlapping pieces meet, pieces with a gap are the gap apart.
+        assert_eq!(segment_segment_min(&p(0.0, 0.0), &p(2.0, 2.0), &p(1.0, 1.0), &p(3.0, 3.0)), 0.0);
+        let gap = segment_segment_min(&p(0.0, 0.0), &p(1.0, 1.0), &p(2.0, 2.0), &p(3.0, 3.0));
+        assert!((gap - 2f64.sqrt()).abs() < 1e-15);
+        // A point on a segment's end, and a degenerate segment (a point) inside another.
+        assert_eq!(segment_segment_min(&p(0.0, 0.0), &p(1.0, 0.0), &p(1.0, 0.0), &p(1.0, 5.0)), 0.0);
+        assert_eq!(segment_segment_min(&p(0.5, 0.0), &p(0.5, 0.0), &p(0.0, 0.0), &p(1.0, 0.0)), 0.0);
     }
 
     #[test]
@@ -378,6 +424,31 @@ mod tests {
             let mx = arc_segment_max(&p, &a, &b);
             let bx = pa.iter().map(|u| point_segment(u, &a, &b)).fold(0.0, f64::max);
             prop_assert!(mx >= bx - 1e-9 && mx - bx < slack, "arc_segment_max {mx} brute {bx}");
+        }
+
+        #[test]
+        fn crossing_segments_meet_whatever_the_angle(
+            (x, y) in (-50.0..50.0f64, -50.0..50.0f64), (u, v) in (-1.0..1.0f64, -1.0..1.0f64),
+            len in 0.5..80.0f64, angle in prop_oneof![Just(1e-9), 1e-7..1e-3f64, 0.01..3.1f64],
+            (t, s) in (0.05..0.95f64, 0.05..0.95f64),
+        ) {
+            // Two segments through one point at any angle down to 1e-9 rad (the rounding of their
+            // ends moves the crossing by at most 1e-5 mm along them): they meet. Cut one 1e-6 mm
+            // before the point, where that leaves it far more than the round-off away, and they
+            // are that far apart.
+            prop_assume!(u.hypot(v) > 0.1);
+            let dir = V2::new(u, v).normalize();
+            let rot = V2::new(dir.x * angle.cos() - dir.y * angle.sin(), dir.x * angle.sin() + dir.y * angle.cos());
+            let x0 = P2::new(x, y);
+            let (a, b) = (x0 - dir * (t * len), x0 + dir * ((1.0 - t) * len));
+            let (c, d) = (x0 - rot * (s * len), x0 + rot * ((1.0 - s) * len));
+            prop_assert_eq!(segment_segment_min(&a, &b, &c, &d), 0.0);
+            if angle >= 1e-3 {
+                let short = x0 - dir * 1e-6;
+                let m = segment_segment_min(&a, &short, &c, &d);
+                let gap = 1e-6 * angle.sin();
+                prop_assert!((m - gap).abs() <= 1e-3 * gap + 1e-13, "{m} vs {gap}");
+            }
         }
 
         #[test]
