@@ -139,7 +139,7 @@ fn wall_pass_corners_are_rounded_and_their_rest_named() {
     // Sharp corners: the wall pass meets the corner's whole quadrant (≥ 90°), a failed check
     // unless the program is asked for anyway.
     let sharp = [sq, "--radius", "5", "--corner-radius", "0", "--report", "s.json", "-o", "s.csv"];
-    assert_eq!(w.run(BIN, &sharp, b"").status, 1);
+    assert_eq!(w.run(BIN, &[&sharp[..], &["--no-leave-uncut"]].concat(), b"").status, 1);
     w.run(BIN, &[&sharp[..], &["--allow-over-threshold"]].concat(), b"").ok();
     let s = report(&w, "s.json");
     assert!(s["largest_engagement_deg"].as_f64().unwrap() >= 90.0, "{s}");
@@ -343,8 +343,8 @@ fn material_no_loop_can_clear_is_named_when_the_threshold_is_not_held() {
     // over the threshold is listed with where it is and why, and a warning is printed.
     let w = Work::new();
     let src = data("medial-trochoid/polygon12.csv");
-    let args = [src.to_str().unwrap(), "--radius", "5", "--report", "r.json", "-o", "t.csv"];
-    // (Today's limit, documented: a remedy for these corners makes this pocket hold.) A failed
+    let args = [src.to_str().unwrap(), "--radius", "5", "--report", "r.json", "-o", "t.csv", "--no-leave-uncut"];
+    // With --no-leave-uncut (by default these corners are left uncut: the next test), a failed
     // check: the report names the places, the program is not written, exit status 1.
     let refused = w.run(BIN, &args, b"");
     assert_eq!(refused.status, 1, "{}", refused.stderr);
@@ -370,4 +370,157 @@ fn material_no_loop_can_clear_is_named_when_the_threshold_is_not_held() {
         let (x, y) = (p[0].as_f64().unwrap() - 50.0, p[1].as_f64().unwrap() - 50.0);
         assert!(x.hypot(y) <= 15.0 - 5.0 + 1e-6, "{p}");
     }
+}
+
+/// Area (mm²) a disk of radius `rho` rolled inside a corner of interior angle `alpha` (radians)
+/// does not reach: between the two sides and the tangent arc.
+fn fillet_area(alpha: f64, rho: f64) -> f64 {
+    rho * rho * (1.0 / (0.5 * alpha).tan() - 0.5 * (std::f64::consts::PI - alpha))
+}
+
+/// The uncut stretches of report `r` as (loop, thickness, thickest point, from, to).
+fn uncut(r: &serde_json::Value) -> Vec<(i64, f64, (f64, f64), (f64, f64), (f64, f64))> {
+    let xy = |v: &serde_json::Value| (v[0].as_f64().unwrap(), v[1].as_f64().unwrap());
+    r["uncut"]
+        .as_array()
+        .unwrap_or_else(|| panic!("uncut in {r}"))
+        .iter()
+        .map(|s| {
+            let len = s["length_mm"].as_f64().unwrap();
+            assert!(len >= 0.0, "{s}");
+            (
+                s["loop"].as_i64().unwrap(),
+                s["thickness_mm"].as_f64().unwrap(),
+                xy(&s["thickest_at"]),
+                xy(&s["from"]),
+                xy(&s["to"]),
+            )
+        })
+        .collect()
+}
+
+#[test]
+fn what_no_program_reaches_under_the_threshold_is_left_uncut_and_named() {
+    // The 12-gon at R5 (48.2° entering its corners with the whole pocket): opened by a disk of
+    // ρ = 1.1 R, its 12 corners are left uncut and the rest holds 40° with no gouge.
+    let w = Work::new();
+    let src = data("medial-trochoid/polygon12.csv");
+    let run = w.run(BIN, &[src.to_str().unwrap(), "--radius", "5", "--report", "r.json", "-o", "t.csv"], b"");
+    run.ok();
+    assert!(
+        run.stderr.contains("left uncut: 12 stretches") && run.stderr.contains("named in the report"),
+        "{}",
+        run.stderr
+    );
+    let r = report(&w, "r.json");
+    let csv = w.read("t.csv");
+    assert_holds(&r, &csv, 5.0);
+    let rho = r["uncut_radius_mm"].as_f64().unwrap();
+    assert!((rho - 5.5).abs() < 1e-12, "{r}");
+    // Independent gouge check: every row's tool centre is R or more from every side.
+    let v: Vec<(f64, f64)> = (0..12)
+        .map(|k| {
+            let a = f64::from(k) * std::f64::consts::TAU / 12.0;
+            (50.0 + 15.0 * a.cos(), 50.0 + 15.0 * a.sin())
+        })
+        .collect();
+    for (_, _, x, y) in rows(&csv) {
+        for k in 0..12 {
+            let (a, b) = (v[k], v[(k + 1) % 12]);
+            let (dx, dy) = (b.0 - a.0, b.1 - a.1);
+            let t = (((x - a.0) * dx + (y - a.1) * dy) / (dx * dx + dy * dy)).clamp(0.0, 1.0);
+            assert!((x - a.0 - t * dx).hypot(y - a.1 - t * dy) >= 5.0 - 1e-5, "({x}, {y}) gouges side {k}");
+        }
+    }
+    // The 12 corners (interior angle 150°): each stretch thickest at its vertex, ρ(1/sin 75° − 1)
+    // thick, around it; the area is 12 fillets' closed form.
+    let alpha = 150f64.to_radians();
+    let st = uncut(&r);
+    assert_eq!(st.len(), 12, "{r}");
+    for (l, t, at, from, to) in &st {
+        assert_eq!(*l, 1);
+        assert!((t - rho * (1.0 / (0.5 * alpha).sin() - 1.0)).abs() < 1e-6, "{t}");
+        let k = v.iter().position(|q| (q.0 - at.0).hypot(q.1 - at.1) < 1e-6).expect("thickest at a vertex");
+        let tangent = rho / (0.5 * alpha).tan();
+        for e in [from, to] {
+            let d = (e.0 - v[k].0).hypot(e.1 - v[k].1);
+            assert!(d > 0.0 && d <= tangent, "{e:?} {d} from the vertex, tangent at {tangent}");
+        }
+    }
+    let area = r["uncut_area_mm2"].as_f64().unwrap();
+    assert!((area - 12.0 * fillet_area(alpha, rho)).abs() < 1e-5, "{area}");
+    assert_eq!(r["opened_regions"], 1);
+}
+
+#[test]
+fn box_die_gaps_beside_the_boss_are_left_uncut_at_r6_and_r5_is_unchanged() {
+    // At R6 the gaps above and below the R5 boss are exactly 2R = 12 mm wide (54.2° there):
+    // opened by ρ = 6.6 mm, the gaps' middles and the convex corners are left uncut.
+    let w = Work::new();
+    let src = data("medial-trochoid/box-die.csv");
+    let args = [src.to_str().unwrap(), "--radius", "6", "--sample", "1", "--report", "r.json"];
+    let run = w.run(BIN, &[&args[..], &["-o", "t.csv"]].concat(), b"");
+    run.ok();
+    assert!(run.stderr.contains("left uncut: 12 stretches"), "{}", run.stderr);
+    let r = report(&w, "r.json");
+    assert_holds(&r, &w.read("t.csv"), 6.0);
+    let rho = r["uncut_radius_mm"].as_f64().unwrap();
+    assert!((rho - 6.6).abs() < 1e-12, "{r}");
+    // Independent area: 8 convex corners' fillets (six of 90°, the acute 58° one at (10, 90),
+    // 122° at (30, 58)) and the two gaps. In each gap the two disks of radius ρ tangent to the
+    // wall and the boss overlap (centres 2·dx apart, dx < ρ): what they leave is a piece on the
+    // wall (under the disks' lower crossing) and a piece under the boss (above the upper one),
+    // each a triangle less the circular segments the disks and the boss bulge into it.
+    let (pi, deg) = (std::f64::consts::PI, |d: f64| d.to_radians());
+    let acute = (32f64).atan2(20.0);
+    let corners = 6.0 * fillet_area(deg(90.0), rho) + fillet_area(acute, rho) + fillet_area(pi - acute, rho);
+    let (bx, by, rb) = (70.0, 27.0, 5.0);
+    let dy = by - 10.0 - rho;
+    let dx = ((rb + rho).powi(2) - dy * dy).sqrt();
+    assert!(dx < rho);
+    let dist = |a: (f64, f64), b: (f64, f64)| (a.0 - b.0).hypot(a.1 - b.1);
+    let segment = |r: f64, a: (f64, f64), b: (f64, f64)| {
+        let th = 2.0 * (dist(a, b) / (2.0 * r)).asin();
+        0.5 * r * r * (th - th.sin())
+    };
+    let triangle = |a: (f64, f64), b: (f64, f64), c: (f64, f64)| {
+        0.5 * ((b.0 - a.0) * (c.1 - a.1) - (c.0 - a.0) * (b.1 - a.1)).abs()
+    };
+    let t = |sx: f64| (bx + sx * dx * rb / (rb + rho), by - dy * rb / (rb + rho));
+    let (w1, w2, t1, t2) = ((bx - dx, 10.0), (bx + dx, 10.0), t(-1.0), t(1.0));
+    let h = (rho * rho - dx * dx).sqrt();
+    let (lo, hi) = ((bx, 10.0 + rho - h), (bx, 10.0 + rho + h));
+    let on_wall = triangle(w1, w2, lo) - 2.0 * segment(rho, w1, lo);
+    let under_boss = triangle(hi, t1, t2) - 2.0 * segment(rho, hi, t1) - segment(rb, t1, t2);
+    let gap = on_wall + under_boss;
+    let area = r["uncut_area_mm2"].as_f64().unwrap();
+    assert!((area - (corners + 2.0 * gap)).abs() < 1e-4, "{area} vs {} + 2 × {gap}", corners);
+    // The stretches: the walls beside the boss (thickest at (70, 10) and (70, 44), the gap's
+    // closed form) and the boss's bottom and top (path 2), besides the corners.
+    let st = uncut(&r);
+    assert_eq!(st.len(), 12, "{r}");
+    let wall_gap = (dx * dx + rho * rho).sqrt() - rho;
+    for y in [10.0, 44.0] {
+        let s = st.iter().find(|s| s.0 == 1 && (s.2.0 - 70.0).abs() < 1e-9 && (s.2.1 - y).abs() < 1e-9);
+        let s = s.unwrap_or_else(|| panic!("no stretch thickest at (70, {y}): {st:?}"));
+        assert!((s.1 - wall_gap).abs() < 1e-6, "{s:?} vs {wall_gap}");
+        for e in [s.3, s.4] {
+            assert!((e.1 - y).abs() < 1e-9 && (e.0 - bx).abs() <= dx, "{s:?}");
+        }
+    }
+    assert_eq!(st.iter().filter(|s| s.0 == 2).count(), 2, "{st:?}");
+    // --no-leave-uncut keeps the refusal.
+    let refused = w.run(BIN, &[&args[..], &["-o", "n.csv", "--no-leave-uncut"]].concat(), b"");
+    assert_eq!(refused.status, 1, "{}", refused.stderr);
+    assert!(!w.path("n.csv").exists());
+    // At R5 the threshold already holds: nothing is left uncut and the program is the same
+    // byte for byte as with --no-leave-uncut.
+    let r5 =
+        [src.to_str().unwrap(), "--radius", "5", "--sample", "1", "--trochoid-radius", "2.5", "--report", "r5.json"];
+    w.run(BIN, &[&r5[..], &["-o", "a.csv"]].concat(), b"").ok();
+    w.run(BIN, &[&r5[..], &["-o", "b.csv", "--no-leave-uncut"]].concat(), b"").ok();
+    assert!(w.read("a.csv") == w.read("b.csv"));
+    let r = report(&w, "r5.json");
+    assert!(r["uncut_radius_mm"].is_null() && r["uncut"].as_array().is_some_and(Vec::is_empty), "{r}");
+    assert_eq!(r["uncut_area_mm2"], 0.0);
 }

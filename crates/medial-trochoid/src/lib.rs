@@ -8,6 +8,8 @@
 //! re-simulates the whole program and estimates both programs' times ([`feed`]). Material the
 //! re-simulation still finds over the threshold makes the medial points within R of it
 //! dangerous too (the plan made again, a few rounds); what no loop can clear is named.
+//! [`plan_leaving_uncut`] then plans the regions opened by a radius ([`uncut`]) instead,
+//! leaving uncut, and naming, the material no program reaches under the threshold.
 
 pub mod angles;
 pub mod corner;
@@ -19,6 +21,7 @@ pub mod plot;
 pub mod program;
 pub mod relink;
 pub mod trochoid;
+pub mod uncut;
 
 use camkit::contour::OffsetOptions;
 use camkit::contour::pocket::{Direction, Pass, Passes, PocketOptions, pocket};
@@ -127,7 +130,33 @@ pub struct Plan {
     /// Samples of cutting moves still over the threshold after the repairs: where the tool
     /// centre is (mm) and the engagement (degrees). Empty when the threshold holds.
     pub left_over: Vec<(P2, f64)>,
+    /// What was left uncut so that the rest holds the threshold ([`plan_leaving_uncut`]): then
+    /// `regions` are the opened regions, planned in place of the input's.
+    pub uncut: Option<Uncut>,
 }
+
+/// Material left uncut: the input regions opened by a radius, and the stretches of their loops
+/// the opening does not reach.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Uncut {
+    /// The opening radius ρ (mm).
+    pub rho: f64,
+    /// The opening radii tried before it, that did not hold the threshold (mm).
+    pub tried: Vec<f64>,
+    /// The input regions (the gouge check is against them).
+    pub original: Vec<Region>,
+    /// Stretches of the input loops left uncut.
+    pub stretches: Vec<uncut::Stretch>,
+    /// Area of the input regions less the opened regions' (mm²).
+    pub area: f64,
+}
+
+/// Opening radii tried when a plan leaves samples over the threshold, as multiples of the wall
+/// distance R + allowance (smallest first, so that as little as possible is left): 1.1 already
+/// drops a gap exactly 2R wide and rounds each inside corner to a wall-pass arc a tenth of the
+/// wall distance; 3 rounds corners to an arc of twice it. A larger opening leaves more than a
+/// finishing tool would take.
+pub const OPENING_LADDER: [f64; 5] = [1.1, 1.25, 1.5, 2.0, 3.0];
 
 /// Round-off of a computed engagement (degrees): a side cut at exactly the threshold's step
 /// over computes to the threshold within this (measured: 1.2e-6° where a rounded corner's
@@ -279,6 +308,53 @@ fn times(
 
 /// The offset-only and the trochoids-first programs of `regions`.
 pub fn plan(regions: &[Region], s: &Settings) -> Result<Plan, PlanError> {
+    plan_in(regions, regions, s)
+}
+
+/// [`plan`], and where its program leaves samples over the threshold, the plan of the regions
+/// opened by the first radius of [`OPENING_LADDER`] whose plan holds it: the material the
+/// opening drops is left uncut and named ([`Plan::uncut`]). Both programs (offset-only and
+/// trochoids-first) are then made in the opened regions, so their times compare like with
+/// like; the gouge check stays against `regions`. If no opening holds, the plan of `regions`.
+pub fn plan_leaving_uncut(regions: &[Region], s: &Settings) -> Result<Plan, PlanError> {
+    let full = plan(regions, s)?;
+    if full.left_over.is_empty() {
+        return Ok(full);
+    }
+    let wall = s.radius + s.allowance;
+    let mut tried = Vec::new();
+    for k in OPENING_LADDER {
+        let rho = wall * k;
+        let Ok(opening) = uncut::open(regions, rho) else {
+            tried.push(rho);
+            continue;
+        };
+        if opening.regions.is_empty() {
+            // Nothing is left to cut at this radius, nor at a larger one.
+            break;
+        }
+        match plan_in(&opening.regions, regions, s) {
+            Ok(mut p) if p.left_over.is_empty() => {
+                let area =
+                    regions.iter().map(uncut::area).sum::<f64>() - opening.regions.iter().map(uncut::area).sum::<f64>();
+                p.uncut = Some(Uncut {
+                    rho,
+                    tried,
+                    original: regions.to_vec(),
+                    stretches: uncut::stretches(regions, &opening.regions, s.sample),
+                    area,
+                });
+                return Ok(p);
+            }
+            _ => tried.push(rho),
+        }
+    }
+    Ok(full)
+}
+
+/// The plan of `regions` with the tool's clearance (the gouge check) measured from `walls`
+/// (the same regions, or the input regions around opened ones).
+fn plan_in(regions: &[Region], walls: &[Region], s: &Settings) -> Result<Plan, PlanError> {
     let wall = s.radius + s.allowance;
     let opts = PocketOptions {
         radius: wall,
@@ -297,7 +373,7 @@ pub fn plan(regions: &[Region], s: &Settings) -> Result<Plan, PlanError> {
         let mine: Vec<Pass> = pocket.passes.iter().filter(|p| p.region == ri).cloned().collect();
         passes_only.push_passes(&mine, region, wall);
     }
-    let offset_only = analyse(passes_only.clone(), s, regions);
+    let offset_only = analyse(passes_only.clone(), s, walls);
     let medial: Vec<Medial> = regions
         .iter()
         .map(|r| medial_axis(r, &s.medial).map_err(|e| PlanError::Medial(e.to_string())))
@@ -330,7 +406,7 @@ pub fn plan(regions: &[Region], s: &Settings) -> Result<Plan, PlanError> {
     // are dangerous too (a loop centred there sweeps it away).
     let mut repair_points: Vec<P2> = Vec::new();
     let mut stretches = dangerous(regions, &medial, &loops, s, |p| grid.any_within(p, reach));
-    let mut built = build(regions, &pocket.passes, &stretches.runs, s, None);
+    let mut built = build(regions, walls, &pocket.passes, &stretches.runs, s, None);
     let mut repair_rounds = 0;
     let mut repairs_exhausted = true;
     // The plan returned is the best of the rounds (fewest samples over, then the lowest
@@ -361,7 +437,7 @@ pub fn plan(regions: &[Region], s: &Settings) -> Result<Plan, PlanError> {
             danger: more.danger,
             uncleared: more.uncleared,
         };
-        let again = build(regions, &pocket.passes, &next.runs, s, Some((&built.trochoidal, kept)));
+        let again = build(regions, walls, &pocket.passes, &next.runs, s, Some((&built.trochoidal, kept)));
         let before = std::mem::replace(&mut built, again);
         let previous = std::mem::replace(&mut stretches, next);
         if best.as_ref().is_none_or(|b| score(&before) < score(&b.0)) {
@@ -395,6 +471,7 @@ pub fn plan(regions: &[Region], s: &Settings) -> Result<Plan, PlanError> {
         repair_points: repair_points.len(),
         repairs_exhausted,
         left_over,
+        uncut: None,
     })
 }
 
@@ -475,8 +552,15 @@ struct Built {
 /// The trochoids-first program: `runs` first, then the pocket's `passes` (the wall passes'
 /// corners fitted), re-simulated, links over the threshold replaced. With `before` (a program
 /// whose runs were the first `k` of `runs`), the engagement along those runs' moves is taken
-/// from it.
-fn build(regions: &[Region], passes: &[Pass], runs: &[Run], s: &Settings, before: Option<(&Analysed, usize)>) -> Built {
+/// from it. The tool's clearance is measured from `walls`.
+fn build(
+    regions: &[Region],
+    walls: &[Region],
+    passes: &[Pass],
+    runs: &[Run],
+    s: &Settings,
+    before: Option<(&Analysed, usize)>,
+) -> Built {
     let wall = s.radius + s.allowance;
     let mut troch = Program::default();
     let mut same = 0;
@@ -504,8 +588,8 @@ fn build(regions: &[Region], passes: &[Pass], runs: &[Run], s: &Settings, before
         first = false;
     }
     let mut trochoidal = match before {
-        Some((a, _)) => analyse_after(troch, s, regions, a, same),
-        None => analyse(troch, s, regions),
+        Some((a, _)) => analyse_after(troch, s, walls, a, same),
+        None => analyse(troch, s, walls),
     };
     // Links over the threshold: their passes started on cleared ground instead (one link a
     // round, re-simulated each time; a second round on the same link makes it a retract).
@@ -526,7 +610,7 @@ fn build(regions: &[Region], passes: &[Pass], runs: &[Run], s: &Settings, before
         };
         relinks.push(how);
         // The moves before the link are the same: their engagement is reused.
-        trochoidal = analyse_after(p, s, regions, &trochoidal, i);
+        trochoidal = analyse_after(p, s, walls, &trochoidal, i);
     }
     Built { passes, rests, trochoidal, relinks }
 }

@@ -14,7 +14,7 @@ use clap::{Parser, ValueEnum};
 use medial_trochoid::feed::FeedModel;
 use medial_trochoid::medial::MedialOptions;
 use medial_trochoid::program::Tag;
-use medial_trochoid::{Analysed, Settings, plan, plot};
+use medial_trochoid::{Analysed, Settings, plan, plan_leaving_uncut, plot};
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Instant;
@@ -84,6 +84,15 @@ struct Args {
     /// the report and plots are written, the program is not, exit status 1.
     #[arg(long)]
     allow_over_threshold: bool,
+    /// Refuse (exit status 1) where the trochoids-first program goes over the threshold, instead
+    /// of leaving uncut what the tool cannot reach under it. By default such a pocket is opened
+    /// by the first of the radii (R + allowance) × 1.1, 1.25, 1.5, 2, 3 whose plan holds the
+    /// threshold: a disk of that radius rolled inside it rounds its inside corners and drops
+    /// gaps narrower than twice the radius; both programs are made in the opened pocket, the
+    /// gouge check stays against the given walls, and the material left is named in the report
+    /// (uncut, uncut_radius_mm, uncut_area_mm2) and in a warning.
+    #[arg(long)]
+    no_leave_uncut: bool,
     /// Snap grid of the Voronoi input (mm).
     #[arg(long, default_value_t = 1e-6, value_name = "MM")]
     resolution: f64,
@@ -142,6 +151,12 @@ fn after_help() -> String {
         "Output rows are samples along the tool-centre path (at most --sample mm apart); tag is entry (helical\n",
     );
     s.push_str("entry loop of a trochoid run), trochoid, contour or link; each chain starts with a rapid row.\n");
+    s.push_str(
+        "Material the tool cannot reach under the threshold is left uncut (see --no-leave-uncut): report keys uncut\n",
+    );
+    s.push_str(
+        "(per stretch: loop = path id, from, to, length_mm, thickness_mm, thickest_at), uncut_radius_mm, uncut_area_mm2.\n",
+    );
     s.push_str("\nExit status: 0 done, 1 a check failed, 2 bad input or usage.");
     s
 }
@@ -227,7 +242,9 @@ fn run(args: Args) -> Result<()> {
     if let Some(given) = &args.analyse {
         return analyse_given(given, &regions, &settings, &args, started);
     }
-    let plan = plan(&regions, &settings).map_err(|e| match e {
+    let leave_uncut = !(args.no_leave_uncut || args.allow_over_threshold);
+    let planned = if leave_uncut { plan_leaving_uncut(&regions, &settings) } else { plan(&regions, &settings) };
+    let plan = planned.map_err(|e| match e {
         medial_trochoid::PlanError::Pocket(_) => Error::check(e.to_string()),
         _ => Error::input(e.to_string()).at(Location::file(&name)),
     })?;
@@ -253,6 +270,18 @@ fn run(args: Args) -> Result<()> {
             p.y
         )
     });
+    if let Some(u) = &plan.uncut {
+        let thickest = u.stretches.iter().max_by(|a, b| a.thickness.total_cmp(&b.thickness));
+        let (t, at) = thickest.map_or((0.0, P2::origin()), |s| (s.thickness, s.thickest_at));
+        cli::warn(&format!(
+            "left uncut: {} stretches, {:.3} mm², thickest {t:.3} mm at ({:.3}, {:.3}): the tool cannot reach them under the threshold ({:.3} mm opening); named in the report",
+            u.stretches.len(),
+            u.area,
+            at.x,
+            at.y,
+            u.rho
+        ));
+    }
     let failed = over.as_ref().filter(|_| args.program == Which::Trochoid && !args.allow_over_threshold);
     if let Some(over) = over.as_ref().filter(|_| failed.is_none()) {
         cli::warn(over);
@@ -328,6 +357,29 @@ fn run(args: Args) -> Result<()> {
                             "no trochoid loop fits within R of the material met there"
                         }
                     )
+                }),
+            )
+            .set("uncut_radius_mm", plan.uncut.as_ref().map(|u| u.rho))
+            .set("uncut_radii_tried_mm", plan.uncut.as_ref().map_or(Vec::new(), |u| u.tried.clone()))
+            .set("uncut_area_mm2", plan.uncut.as_ref().map_or(0.0, |u| u.area))
+            .set("opened_regions", plan.uncut.as_ref().map(|_| plan.regions.len()))
+            .set(
+                "uncut",
+                plan.uncut.as_ref().map_or(Vec::new(), |u| {
+                    u.stretches
+                        .iter()
+                        .map(|st| {
+                            let (a, b) = (st.points[0], st.points[st.points.len() - 1]);
+                            serde_json::json!({
+                                "loop": sources[st.source].path,
+                                "from": [a.x, a.y],
+                                "to": [b.x, b.y],
+                                "length_mm": st.length,
+                                "thickness_mm": st.thickness,
+                                "thickest_at": [st.thickest_at.x, st.thickest_at.y],
+                            })
+                        })
+                        .collect()
                 }),
             )
             .set("relinked", plan.relinks.len())

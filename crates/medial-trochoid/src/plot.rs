@@ -43,6 +43,11 @@ fn coloured(p: &mut Plot, a: &Analysed, width: f64) {
 
 /// The contours of `regions` in black.
 fn contours(p: &mut Plot, regions: &[Region]) {
+    outlines(p, regions, &Style::stroke("black", 1.6));
+}
+
+/// The loops of `regions` drawn with `style`.
+fn outlines(p: &mut Plot, regions: &[Region], style: &Style) {
     for r in regions {
         for c in r.loops() {
             if let Some(first) = c.vertices.first() {
@@ -53,7 +58,7 @@ fn contours(p: &mut Plot, regions: &[Region]) {
                         Seg::Arc(a) => Piece::Arc(a),
                     })
                     .collect();
-                p.path(first.p, pieces, true, Style::stroke("black", 1.6));
+                p.path(first.p, pieces, true, style.clone());
             }
         }
     }
@@ -69,10 +74,25 @@ pub fn given_plot(title: &str, regions: &[Region], a: &Analysed) -> Plot {
     p
 }
 
-/// The plot of one program of the plan (`trochoidal` or offset-only).
+/// The plot of one program of the plan (`trochoidal` or offset-only). Where material was left
+/// uncut, the input contours are drawn in black, the opened ones dashed, and the uncut stretches
+/// of the input contours in magenta.
 pub fn plan_plot(title: &str, plan: &Plan, trochoidal: bool) -> Plot {
     let mut p = Plot::new(title, Aspect::Equal);
-    contours(&mut p, &plan.regions);
+    let opened = Style::stroke("#555555", 1.0).dashed("6 3");
+    let uncut = Style::stroke("#e377c2", 4.0);
+    match &plan.uncut {
+        Some(u) => {
+            contours(&mut p, &u.original);
+            outlines(&mut p, &plan.regions, &opened);
+            for st in &u.stretches {
+                p.polyline(&st.points, uncut.clone());
+            }
+            p.legend(&format!("opened contour ({:.3} mm disk rolled inside)", u.rho), opened)
+                .legend("left uncut (tool cannot reach it under the threshold)", uncut);
+        }
+        None => contours(&mut p, &plan.regions),
+    }
     let a = if trochoidal { &plan.trochoidal } else { &plan.offset_only };
     coloured(&mut p, a, 0.8);
     for m in &plan.medial {
