@@ -524,3 +524,27 @@ fn box_die_gaps_beside_the_boss_are_left_uncut_at_r6_and_r5_is_unchanged() {
     assert!(r["uncut_radius_mm"].is_null() && r["uncut"].as_array().is_some_and(Vec::is_empty), "{r}");
     assert_eq!(r["uncut_area_mm2"], 0.0);
 }
+
+#[test]
+fn a_pocket_no_opening_makes_hold_is_still_refused() {
+    // A step of 3 mm at R5: every side cut engages acos(1 − 3/5) = 66.4°, so no opening of the
+    // pocket holds 40°: the refusal stays (exit 1, no program), naming the radii tried.
+    let w = Work::new();
+    let src = data("medial-trochoid/square.csv");
+    let args =
+        [src.to_str().unwrap(), "--radius", "5", "--step", "3", "--sample", "1", "--report", "r.json", "-o", "t.csv"];
+    let refused = w.run(BIN, &args, b"");
+    assert_eq!(refused.status, 1, "{}", refused.stderr);
+    assert!(refused.stderr.contains("opened by 5.500 to 15.000 mm"), "{}", refused.stderr);
+    assert!(!w.path("t.csv").exists());
+    let r = report(&w, "r.json");
+    let tried: Vec<f64> = r["uncut_radii_tried_mm"].as_array().unwrap().iter().map(|v| v.as_f64().unwrap()).collect();
+    let ladder = [1.1, 1.25, 1.5, 2.0, 3.0];
+    assert_eq!(tried.len(), ladder.len(), "{r}");
+    for (t, k) in tried.iter().zip(ladder) {
+        assert!((t - 5.0 * k).abs() < 1e-12, "{tried:?}");
+    }
+    assert!(r["uncut_radius_mm"].is_null() && r["uncut"].as_array().is_some_and(Vec::is_empty), "{r}");
+    let side_cut = (1.0 - 3.0 / 5.0f64).acos().to_degrees();
+    assert!((r["largest_engagement_deg"].as_f64().unwrap() - side_cut).abs() < 1e-3, "{r}");
+}

@@ -133,6 +133,9 @@ pub struct Plan {
     /// What was left uncut so that the rest holds the threshold ([`plan_leaving_uncut`]): then
     /// `regions` are the opened regions, planned in place of the input's.
     pub uncut: Option<Uncut>,
+    /// Opening radii tried by [`plan_leaving_uncut`] whose plan did not hold the threshold
+    /// (mm, in the order tried; all of [`OPENING_LADDER`] when none held).
+    pub openings_tried: Vec<f64>,
 }
 
 /// Material left uncut: the input regions opened by a radius, and the stretches of their loops
@@ -141,8 +144,6 @@ pub struct Plan {
 pub struct Uncut {
     /// The opening radius ρ (mm).
     pub rho: f64,
-    /// The opening radii tried before it, that did not hold the threshold (mm).
-    pub tried: Vec<f64>,
     /// The input regions (the gouge check is against them).
     pub original: Vec<Region>,
     /// Stretches of the input loops left uncut.
@@ -317,7 +318,7 @@ pub fn plan(regions: &[Region], s: &Settings) -> Result<Plan, PlanError> {
 /// trochoids-first) are then made in the opened regions, so their times compare like with
 /// like; the gouge check stays against `regions`. If no opening holds, the plan of `regions`.
 pub fn plan_leaving_uncut(regions: &[Region], s: &Settings) -> Result<Plan, PlanError> {
-    let full = plan(regions, s)?;
+    let mut full = plan(regions, s)?;
     if full.left_over.is_empty() {
         return Ok(full);
     }
@@ -337,9 +338,9 @@ pub fn plan_leaving_uncut(regions: &[Region], s: &Settings) -> Result<Plan, Plan
             Ok(mut p) if p.left_over.is_empty() => {
                 let area =
                     regions.iter().map(uncut::area).sum::<f64>() - opening.regions.iter().map(uncut::area).sum::<f64>();
+                p.openings_tried = tried;
                 p.uncut = Some(Uncut {
                     rho,
-                    tried,
                     original: regions.to_vec(),
                     stretches: uncut::stretches(regions, &opening.regions, s.sample),
                     area,
@@ -349,6 +350,7 @@ pub fn plan_leaving_uncut(regions: &[Region], s: &Settings) -> Result<Plan, Plan
             _ => tried.push(rho),
         }
     }
+    full.openings_tried = tried;
     Ok(full)
 }
 
@@ -472,6 +474,7 @@ fn plan_in(regions: &[Region], walls: &[Region], s: &Settings) -> Result<Plan, P
         repairs_exhausted,
         left_over,
         uncut: None,
+        openings_tried: Vec::new(),
     })
 }
 

@@ -262,8 +262,12 @@ fn run(args: Args) -> Result<()> {
     // user asked for the program anyway.
     let over = (!plan.left_over.is_empty()).then(|| {
         let (p, e) = plan.left_over.iter().fold(plan.left_over[0], |w, x| if x.1 > w.1 { *x } else { w });
+        let openings = match (plan.openings_tried.first(), plan.openings_tried.last()) {
+            (Some(a), Some(b)) => format!(" (nor did the pocket opened by {a:.3} to {b:.3} mm, to leave uncut what the tool cannot reach)"),
+            _ => String::new(),
+        };
         format!(
-            "{} samples still over the threshold after {} repair rounds (the worst {e:.3}° at ({:.3}, {:.3})): listed in the report",
+            "{} samples still over the threshold after {} repair rounds{openings} (the worst {e:.3}° at ({:.3}, {:.3})): listed in the report",
             plan.left_over.len(),
             plan.repair_rounds,
             p.x,
@@ -360,7 +364,7 @@ fn run(args: Args) -> Result<()> {
                 }),
             )
             .set("uncut_radius_mm", plan.uncut.as_ref().map(|u| u.rho))
-            .set("uncut_radii_tried_mm", plan.uncut.as_ref().map_or(Vec::new(), |u| u.tried.clone()))
+            .set("uncut_radii_tried_mm", &plan.openings_tried)
             .set("uncut_area_mm2", plan.uncut.as_ref().map_or(0.0, |u| u.area))
             .set("opened_regions", plan.uncut.as_ref().map(|_| plan.regions.len()))
             .set(
