@@ -463,9 +463,24 @@ fn box_die_gaps_beside_the_boss_are_left_uncut_at_r6_and_r5_is_unchanged() {
     run.ok();
     assert!(run.stderr.contains("left uncut: 12 stretches"), "{}", run.stderr);
     let r = report(&w, "r.json");
-    assert_holds(&r, &w.read("t.csv"), 6.0);
+    let csv = w.read("t.csv");
+    assert_holds(&r, &csv, 6.0);
     let rho = r["uncut_radius_mm"].as_f64().unwrap();
     assert!((rho - 6.6).abs() < 1e-12, "{r}");
+    // Independent gouge check against the input walls: every row's tool centre is R or more
+    // from the cavity's 12 sides and outside the boss grown by R.
+    #[rustfmt::skip]
+    let v = [(10.0, 10.0), (90.0, 10.0), (90.0, 44.0), (60.0, 44.0), (60.0, 58.0), (90.0, 58.0), (90.0, 90.0),
+        (10.0, 90.0), (30.0, 58.0), (40.0, 58.0), (40.0, 44.0), (10.0, 44.0)];
+    for (_, _, x, y) in rows(&csv) {
+        for k in 0..v.len() {
+            let (a, b): ((f64, f64), (f64, f64)) = (v[k], v[(k + 1) % v.len()]);
+            let (dx, dy) = (b.0 - a.0, b.1 - a.1);
+            let t = (((x - a.0) * dx + (y - a.1) * dy) / (dx * dx + dy * dy)).clamp(0.0, 1.0);
+            assert!((x - a.0 - t * dx).hypot(y - a.1 - t * dy) >= 6.0 - 1e-5, "({x}, {y}) gouges side {k}");
+        }
+        assert!((x - 70.0).hypot(y - 27.0) >= 5.0 + 6.0 - 1e-5, "({x}, {y}) gouges the boss");
+    }
     // Independent area: 8 convex corners' fillets (six of 90°, the acute 58° one at (10, 90),
     // 122° at (30, 58)) and the two gaps. In each gap the two disks of radius ρ tangent to the
     // wall and the boss overlap (centres 2·dx apart, dx < ρ): what they leave is a piece on the
