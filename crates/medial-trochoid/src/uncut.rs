@@ -36,8 +36,6 @@ pub struct Opening {
     /// islands' sources are that region's outer source too: an opened island need not match an
     /// input one).
     pub regions: Vec<Region>,
-    /// For each opened region, the index of the input region it lies in.
-    pub of: Vec<usize>,
 }
 
 /// Why an opening could not be made.
@@ -55,8 +53,8 @@ impl fmt::Display for OpenError {
 /// everywhere has no opened piece.
 pub fn open(regions: &[Region], rho: f64) -> Result<Opening, OpenError> {
     let opts = OffsetOptions::default();
-    let mut out = Opening { rho, regions: Vec::new(), of: Vec::new() };
-    for (ri, region) in regions.iter().enumerate() {
+    let mut out = Opening { rho, regions: Vec::new() };
+    for region in regions {
         let shrunk = offset_region(region, rho, &opts).map_err(|e| OpenError(format!("shrinking by {rho} mm: {e}")))?;
         if shrunk.contours.is_empty() {
             continue;
@@ -67,7 +65,6 @@ pub fn open(regions: &[Region], rho: f64) -> Result<Opening, OpenError> {
             piece.outer_source = region.outer_source;
             piece.island_sources = vec![region.outer_source; piece.islands.len()];
             out.regions.push(piece);
-            out.of.push(ri);
         }
     }
     Ok(out)
