@@ -453,6 +453,67 @@ fn three_d_square_on_a_tilted_plane_is_offset_in_that_plane() {
     assert_eq!(rep["rounded_corners"], 4);
 }
 
+/// A flat star whose spikes are narrower than 2R beside reflex corners (found by fuzzing the 3D
+/// mode): with the default look-ahead (4R each side) a trimmed row's point came nearer than R to
+/// a part of the contour beyond the window; the window now doubles until the check passes. The
+/// result follows the contour at R (every written point within [R, R + chord tolerance]) on the
+/// inside. A window the user gives is kept, and the check refuses it (exit 1).
+#[test]
+fn three_d_window_grows_until_the_contour_is_cleared() {
+    let w = Work::new();
+    let star = [
+        (23.607, 0.0),
+        (15.83, 3.484),
+        (23.99, 11.099),
+        (12.381, 9.412),
+        (11.124, 13.097),
+        (11.147, 21.025),
+        (7.887, 28.408),
+        (1.409, 25.984),
+        (-3.202, 19.53),
+        (-5.674, 14.24),
+        (-12.533, 18.484),
+        (-13.047, 12.359),
+        (-24.067, 14.481),
+        (-27.158, 9.151),
+        (-22.953, 2.496),
+        (-16.317, -1.775),
+        (-22.224, -7.488),
+        (-21.844, -13.143),
+        (-18.827, -17.834),
+        (-13.998, -20.645),
+        (-8.939, -22.435),
+        (-2.641, -16.107),
+        (1.157, -21.339),
+        (7.987, -28.765),
+        (9.571, -18.052),
+        (13.692, -16.119),
+        (14.933, -11.351),
+        (23.138, -10.705),
+        (25.718, -5.661),
+    ];
+    let mut csv = String::from("path,move,x,y,z,i,j,k\n");
+    for (k, (x, y)) in star.iter().chain(&star[..1]).enumerate() {
+        csv.push_str(&format!("0,{},{x},{y},0,0,0,1\n", if k == 0 { "rapid" } else { "line" }));
+    }
+    w.write("star.csv", csv);
+    let out = w.run(BIN, &["star.csv", "--3d", "--radius", "5", "--side", "left", "--report", "s.json"], b"").ok();
+    let rep = report(&w, "s.json");
+    assert_eq!(rep["window_doublings"], 1, "{rep}");
+    assert!(rep["largest_gouge_mm"].as_f64().unwrap() <= 1e-9);
+    let poly = pts(&star);
+    let inside = camkit::contour::Contour::polygon(&poly, true);
+    let rows = table(&out);
+    assert!(rows.len() > star.len());
+    for r in &rows {
+        let p = P2::new(num(r, "x"), num(r, "y"));
+        let d = polygon_distance(&p, &poly);
+        assert!((5.0 - TOL..=5.0 + 0.001 + TOL).contains(&d), "{p} at {d}");
+        assert_ne!(inside.winding_number(&p), 0, "{p} inside the star");
+    }
+    w.run(BIN, &["star.csv", "--3d", "--radius", "5", "--side", "left", "--window", "20"], b"").fails(1, "comes 0.09");
+}
+
 #[test]
 fn zero_length_moves_are_dropped_and_counted() {
     let w = Work::new();

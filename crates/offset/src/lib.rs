@@ -396,7 +396,40 @@ impl Profile {
 }
 
 /// 3D mode: each pass a 3D contour with a tool axis per row, offset normal to the axis.
-pub fn space_mode(table: &Table, name: &str, opts: &space::Options) -> Result<Outcome> {
+///
+/// With `grow_window`, a result that gouges its own pass (the look-ahead missed a part of the
+/// contour farther along it than the window but near in space) is made again with the window
+/// doubled, until the window spans the longest pass.
+pub fn space_mode(table: &Table, name: &str, opts: &space::Options, grow_window: bool) -> Result<Outcome> {
+    let mut o = *opts;
+    loop {
+        match space_try(table, name, &o)? {
+            Tried::Done(mut outcome) => {
+                outcome.report.set("window_doublings", (o.window / opts.window).log2().round() as u32);
+                return Ok(*outcome);
+            }
+            Tried::Gouge { error, own_pass, longest } => {
+                if grow_window && own_pass && o.window < longest {
+                    o.window *= 2.0;
+                    continue;
+                }
+                return Err(error);
+            }
+        }
+    }
+}
+
+/// One try of [`space_mode`] at the window of `opts`.
+enum Tried {
+    /// A result that passed the gouge check.
+    Done(Box<Outcome>),
+    /// The gouge check failed: the error, whether an output came too near its own pass, and the
+    /// longest pass (mm).
+    Gouge { error: Error, own_pass: bool, longest: f64 },
+}
+
+/// [`space_mode`] once: every pass offset at the window of `opts`, then the gouge check.
+fn space_try(table: &Table, name: &str, opts: &space::Options) -> Result<Tried> {
     let mut report = Report::new("offset");
     report
         .set("mode", "3d")
@@ -500,13 +533,16 @@ pub fn space_mode(table: &Table, name: &str, opts: &space::Options) -> Result<Ou
     let gouge = space::gouge(&outputs, &inputs, opts.radius);
     if gouge.depth > opts.chord_tol {
         let (o, k) = gouge.at;
-        return Err(Error::check(format!(
+        let longest =
+            inputs.iter().map(|p| p.windows(2).map(|w| (w[1] - w[0]).norm()).sum::<f64>()).fold(0.0, f64::max);
+        let error = Error::check(format!(
             "the offset of the pass starting at line {} comes {:.4} mm nearer than R = {} mm to the contour of the \
              pass starting at line {} (its move to point {k}): the tool does not fit there (each pass is offset \
              on its own: passes closer than 2R, or bays narrower than 2R, need a smaller tool)",
             first_lines[o], gouge.depth, opts.radius, first_lines[gouge.input]
         ))
-        .at(Location::file(name).line(first_lines[o])));
+        .at(Location::file(name).line(first_lines[o]));
+        return Ok(Tried::Gouge { error, own_pass: o == gouge.input, longest });
     }
     report
         .set("output_paths", path)
@@ -521,7 +557,7 @@ pub fn space_mode(table: &Table, name: &str, opts: &space::Options) -> Result<Ou
         &drawn_in,
         &drawn_out,
     );
-    Ok(Outcome { table: out, report, plot, warnings: Vec::new() })
+    Ok(Tried::Done(Box::new(Outcome { table: out, report, plot, warnings: Vec::new() })))
 }
 
 /// Passes for [`pocket_mode`] from the command line's choice.

@@ -84,7 +84,8 @@ struct Args {
     /// 3D mode: offset normal to each row's tool axis (i,j,k).
     #[arg(long = "3d")]
     three_d: bool,
-    /// 3D mode: look-ahead along the contour on each side of a row (mm); default 4 R.
+    /// 3D mode: look-ahead along the contour on each side of a row (mm); default 4 R, doubled
+    /// while the result comes nearer than R to its own contour (up to the contour's length).
     #[arg(long, value_name = "MM")]
     window: Option<f64>,
     /// 3D mode: largest distance beyond R of a point around a convex corner (mm).
@@ -231,7 +232,7 @@ fn run(args: Args) -> Result<()> {
             chord_tol: positive(args.chord_tol, "--chord-tol")?,
             offset: opts,
         };
-        offset::space_mode(&table, &name, &o)?
+        offset::space_mode(&table, &name, &o, args.window.is_none())?
     } else {
         offset::contour_mode(&table, &name, r, side(&args, true)?, &opts)?
     };

@@ -144,6 +144,18 @@ fn window(pts: &[P3], closed: bool, i: usize, w: f64) -> (Vec<usize>, bool) {
     (out, whole)
 }
 
+/// Smallest distance from the move `a`–`b` to the polyline `poly` (closed if `closed`).
+fn move_distance(a: &P2, b: &P2, poly: &[P2], closed: bool) -> f64 {
+    let d = poly
+        .windows(2)
+        .map(|w| camkit::geom::dist::segment_segment_min(a, b, &w[0], &w[1]))
+        .fold(f64::INFINITY, f64::min);
+    match (closed && poly.len() > 2, poly.first(), poly.last()) {
+        (true, Some(f), Some(l)) => d.min(camkit::geom::dist::segment_segment_min(a, b, l, f)),
+        _ => d,
+    }
+}
+
 /// Distance from `q` to the polyline `poly` (closed if `closed`).
 fn poly_distance(q: &P2, poly: &[P2], closed: bool) -> f64 {
     let mut d = camkit::geom::dist::point_polyline(q, poly);
@@ -209,24 +221,28 @@ pub fn offset(pts: &[P3], axes: &[V3], closed: bool, opts: &Options) -> Result<O
             } else {
                 points.push(P2::origin() + bis * corner);
             }
-            let clear = points.iter().all(|q| poly_distance(q, &poly, whole) >= r - 1e-9 * r.max(1.0));
+            // Clear: the corner points, and the moves from the offsets of the two pieces' middles
+            // to them (the neighbours' moves meet these there), keep R from the window.
+            let lim = r - 1e-9 * r.max(1.0);
+            let moves = [
+                (mid_offset(&poly, whole, at, false, s, r), points.first()),
+                (mid_offset(&poly, whole, at, true, s, r), points.last()),
+            ];
+            let clear = points.iter().all(|q| poly_distance(q, &poly, whole) >= lim)
+                && moves.iter().all(|(mid, end)| match (mid, end) {
+                    (Some(a), Some(b)) => move_distance(a, b, &poly, whole) >= lim,
+                    _ => true,
+                });
             let mut trimmed = false;
             if !clear {
                 // Loops to remove: the verified offset of the window, nearest its corner point.
                 let c = Contour::polygon(&poly, whole);
                 let off =
                     offset_contour(&c, r, opts.side, &opts.offset).map_err(|e| Error3::Offset(i, e.to_string()))?;
-                let target = P2::origin() + bis * r;
-                let best = off
-                    .contours
-                    .iter()
-                    .flat_map(|c| c.segs().collect::<Vec<_>>())
-                    .map(|seg| nearest_on(&seg, &target))
-                    .min_by(|a, b| (a - target).norm().total_cmp(&(b - target).norm()))
-                    .ok_or_else(|| {
-                        Error3::Offset(i, "the window's offset is empty: the tool does not fit here".into())
-                    })?;
-                points = vec![best];
+                if off.contours.is_empty() {
+                    return Err(Error3::Offset(i, "the window's offset is empty: the tool does not fit here".into()));
+                }
+                points = owned_stretch(&off.contours, &poly, whole, at, s, r, opts.chord_tol);
                 trimmed = true;
             }
             let gaps: Vec<f64> = points.iter().map(|q| poly_distance(q, &poly, whole) - r).collect();
@@ -264,25 +280,115 @@ struct RowOffset {
     below: f64,
 }
 
-/// The point of `seg` nearest `p`.
-fn nearest_on(seg: &camkit::contour::Seg, p: &P2) -> P2 {
-    match seg {
-        camkit::contour::Seg::Line(a, b) => {
-            let d = b - a;
-            let l2 = d.norm_squared();
-            let t = if l2 > 0.0 { ((p - a).dot(&d) / l2).clamp(0.0, 1.0) } else { 0.0 };
-            a + d * t
+/// The neighbour of window point `at` before it (`fwd` false) or after it, if any.
+fn neighbour(m: usize, whole: bool, at: usize, fwd: bool) -> Option<usize> {
+    match fwd {
+        true if at + 1 < m => Some(at + 1),
+        false if at > 0 => Some(at - 1),
+        _ if whole && m > 2 => Some(if fwd { 0 } else { m - 1 }),
+        _ => None,
+    }
+}
+
+/// The offset by `r` to side `s` of the middle of the piece between window point `at` and its
+/// neighbour before it (`fwd` false) or after it: where the moves of two neighbouring rows meet.
+fn mid_offset(poly: &[P2], whole: bool, at: usize, fwd: bool, s: f64, r: f64) -> Option<P2> {
+    let k = neighbour(poly.len(), whole, at, fwd)?;
+    let (a, b) = if fwd { (poly[at], poly[k]) } else { (poly[k], poly[at]) };
+    let d = (b - a).try_normalize(1e-15)?;
+    Some(P2::from((a.coords + b.coords) * 0.5) + V2::new(-d.y, d.x) * (s * r))
+}
+
+/// The part of the window's verified offset `loops` (of the window polyline `poly`, closed if
+/// `whole`) that window point `at` owns: the offset points whose nearest point of `poly` lies on
+/// its two pieces no farther than their middles, ordered as the path runs (by that nearest
+/// point, and around the corner by angle), from the offset of the first middle to that of the
+/// second where those are valid. Arcs become polygons around them (vertices `chord_tol` or less
+/// beyond the arc, so no chord cuts it). One point per row is not enough where the offset bends
+/// between rows (round a reflex corner next to a trimmed one): the move between two such points
+/// cut the corner. Empty if the row owns no point of the offset.
+fn owned_stretch(loops: &[Contour], poly: &[P2], whole: bool, at: usize, s: f64, r: f64, chord_tol: f64) -> Vec<P2> {
+    let m = poly.len();
+    let v = poly[at];
+    let (prev, next) = (neighbour(m, whole, at, false), neighbour(m, whole, at, true));
+    let half = |k: Option<usize>| k.map_or(0.0, |k| 0.5 * (poly[k] - v).norm());
+    let reach = half(prev).max(half(next)) + r + chord_tol;
+    let pieces: Vec<(P2, P2)> =
+        (0..m - 1).map(|k| (poly[k], poly[k + 1])).chain((whole && m > 2).then(|| (poly[m - 1], poly[0]))).collect();
+    // Where along the row's two half pieces the nearest window point of `q` lies: −1/2 … 0 on
+    // the piece before, 0 … 1/2 on the piece after; None if elsewhere.
+    let key = |q: &P2| -> Option<f64> {
+        if (q - v).norm() > reach {
+            return None;
         }
-        camkit::contour::Seg::Arc(arc) => {
-            let phi = camkit::geom::arc::angle_of(&(p - arc.c));
-            if arc.spans(phi) {
-                arc.point_at(phi)
-            } else {
-                let (s, e) = (arc.start_point(), arc.end_point());
-                if (s - p).norm() <= (e - p).norm() { s } else { e }
+        let d = pieces.iter().map(|(a, b)| camkit::geom::dist::point_segment(q, a, b)).fold(f64::INFINITY, f64::min);
+        let along = |k: usize, fwd: bool| {
+            let w = poly[k] - v;
+            let t = ((q - v).dot(&w) / w.norm_squared()).clamp(0.0, 1.0);
+            let foot = v + w * t;
+            ((q - foot).norm() <= d * (1.0 + 1e-12) && t <= 0.5).then_some(if fwd { t } else { -t })
+        };
+        prev.and_then(|k| along(k, false)).or_else(|| next.and_then(|k| along(k, true)))
+    };
+    // Around the corner (nearest point the corner itself) the path turns from the normal of
+    // the piece before to that of the piece after.
+    let normal = |k: usize, fwd: bool| {
+        let d = if fwd { poly[k] - v } else { v - poly[k] };
+        V2::new(-d.y, d.x) * s
+    };
+    let n_in = prev.map(|k| normal(k, false)).or_else(|| next.map(|k| normal(k, true)));
+    let turn = |q: &P2| {
+        n_in.map_or(0.0, |n| {
+            let w = q - v;
+            let a = n.angle(&w);
+            let out = next.map_or(n, |k| normal(k, true));
+            if cross2(&n, &out) * cross2(&n, &w) >= 0.0 { a } else { -a }
+        })
+    };
+    let mut owned: Vec<(f64, f64, P2)> = Vec::new();
+    let mut take = |q: P2| {
+        if let Some(k) = key(&q) {
+            owned.push((k, if k == 0.0 { turn(&q) } else { 0.0 }, q));
+        }
+    };
+    for c in loops {
+        for seg in c.segs() {
+            match seg {
+                camkit::contour::Seg::Line(a, b) => {
+                    take(a);
+                    take(b);
+                }
+                camkit::contour::Seg::Arc(arc) => {
+                    let step = 2.0 * (arc.r / (arc.r + chord_tol)).acos();
+                    let k = ((arc.sweep.abs() / step).ceil() as usize).max(1);
+                    let delta = arc.sweep / k as f64;
+                    take(arc.start_point());
+                    for j in 0..k {
+                        let phi = arc.start + (j as f64 + 0.5) * delta;
+                        take(arc.c + V2::new(phi.cos(), phi.sin()) * (arc.r / (0.5 * delta).cos()));
+                    }
+                    take(arc.end_point());
+                }
             }
         }
     }
+    if owned.is_empty() {
+        // Nothing of the offset comes from this row's pieces (a spike narrower than 2R): the
+        // neighbours' stretches meet at the junction.
+        return Vec::new();
+    }
+    owned.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.total_cmp(&b.1)));
+    let mut out: Vec<P2> = Vec::with_capacity(owned.len() + 2);
+    let valid = |q: &P2| poly_distance(q, poly, whole) >= r - 1e-9 * r.max(1.0);
+    let ends = [mid_offset(poly, whole, at, false, s, r), mid_offset(poly, whole, at, true, s, r)];
+    for q in
+        ends[0].iter().filter(|q| valid(q)).chain(owned.iter().map(|o| &o.2)).chain(ends[1].iter().filter(|q| valid(q)))
+    {
+        if out.last().is_none_or(|l: &P2| (l - q).norm() > camkit::tol::POINT_EPS) {
+            out.push(*q);
+        }
+    }
+    out
 }
 
 /// The worst place where the straight moves of the offset paths come near an input contour.
@@ -349,6 +455,75 @@ pub fn gouge(outputs: &[Track], inputs: &[&[P3]], r: f64) -> Gouge {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A star of `n` vertices at radii 15–30 mm (counter-clockwise, z = 0), from `seed`.
+    fn star(seed: u64, n: usize) -> Vec<P3> {
+        let mut x = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        (0..n)
+            .map(|k| {
+                x = x.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+                let r = 15.0 + 15.0 * (x >> 11) as f64 / (1u64 << 53) as f64;
+                let a = std::f64::consts::TAU * k as f64 / n as f64;
+                P3::new(r * a.cos(), r * a.sin(), 0.0)
+            })
+            .collect()
+    }
+
+    /// Flat stars (one tool axis) with spikes narrower than 2R beside reflex corners: offset with
+    /// the whole contour in every window, the 3D result follows the verified 2D offset within
+    /// the chord tolerance both ways (every output point near the 2D path, every point of the 2D
+    /// path near the output polyline), and no move comes nearer than R to the contour. Found by
+    /// fuzzing: one point per trimmed row cut the corner between rows by up to 1.4 mm.
+    #[test]
+    fn flat_stars_follow_the_verified_2d_offset() {
+        let tol = 1e-3;
+        let mut trimmed = 0;
+        for (seed, n) in [(1, 29), (2, 22), (3, 25), (4, 14), (5, 30), (6, 18)] {
+            let pts = star(seed, n);
+            let axes = vec![V3::z(); n];
+            let flat: Vec<P2> = pts.iter().map(|p| P2::new(p.x, p.y)).collect();
+            for side in [Side::Left, Side::Right] {
+                let opts = Options { radius: 5.0, side, window: 1e4, chord_tol: tol, offset: OffsetOptions::default() };
+                let o = offset(&pts, &axes, true, &opts).expect("an offset");
+                trimmed += o.trimmed;
+                let mut ring: Vec<P3> = o.points.iter().map(|p| p.p).collect();
+                ring.push(ring[0]);
+                let two_d = offset_contour(&Contour::polygon(&flat, true), 5.0, side, &OffsetOptions::default())
+                    .expect("the 2D offset");
+                let near_2d = |q: &P2| {
+                    two_d
+                        .contours
+                        .iter()
+                        .flat_map(|c| c.segs().collect::<Vec<_>>())
+                        .map(|s| s.distance_to(q))
+                        .fold(f64::INFINITY, f64::min)
+                };
+                for p in &ring {
+                    let d = near_2d(&P2::new(p.x, p.y));
+                    assert!(d <= tol + 1e-9, "seed {seed} {side:?}: output point {p} is {d} from the 2D offset");
+                }
+                let flat_ring: Vec<P2> = ring.iter().map(|p| P2::new(p.x, p.y)).collect();
+                for c in &two_d.contours {
+                    for seg in c.segs() {
+                        for k in 0..=20 {
+                            let q = seg.point_at(k as f64 / 20.0);
+                            let d = camkit::geom::dist::point_polyline(&q, &flat_ring);
+                            assert!(
+                                d <= tol + 1e-9,
+                                "seed {seed} {side:?}: the 2D offset at {q} is {d} from the output"
+                            );
+                        }
+                    }
+                }
+                let mut input = pts.clone();
+                input.push(pts[0]);
+                let track_axes = vec![V3::z(); ring.len()];
+                let g = gouge(&[Track { pts: &ring, axes: &track_axes }], &[&input], 5.0);
+                assert!(g.depth <= 1e-9, "seed {seed} {side:?}: a move {} mm nearer than R", g.depth);
+            }
+        }
+        assert!(trimmed > 20, "rows taken from the 2D offset: {trimmed}");
+    }
 
     /// A move `dy` beside the x axis at height `dz`, with tool axis `axis`, against R = 1.
     fn depth(dy: f64, dz: f64, axis: V3) -> Gouge {
