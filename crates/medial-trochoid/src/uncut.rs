@@ -3,29 +3,20 @@
 //! loops that the opening does not reach.
 //!
 //! The opening shrinks the region by ρ (`camkit::contour::offset_region`, verified) and grows
-//! what is left by ρ again. The growth is one cavalier_contours shape offset of all the shrunk
-//! loops together, outward by ρ, so that two pieces whose disks overlap (a neck just under 2ρ
-//! wide) come out merged as one loop (the shape offset keeps only the slices at ρ or more from
-//! every shrunk loop: the boundary of the union); it is verified like every camkit offset
-//! (`check_offset`: each output piece at ρ within `OFFSET_TOL` from the shrunk loops, none
-//! missing) and nested again into regions.
+//! what is left by ρ again (`camkit::contour::offset::grow_region`: all the shrunk loops together,
+//! so that two pieces whose disks overlap, at a neck just under 2ρ wide, come out merged as one
+//! loop, the boundary of their union; verified: each output piece at ρ within `OFFSET_TOL` from
+//! the shrunk loops, none missing), nested again into regions.
 
-use camkit::contour::offset::{OffsetOptions, Side, check_offset, offset_region};
+use camkit::contour::offset::{OffsetOptions, grow_region, offset_region};
 use camkit::contour::region::{Region, regions as nest};
-use camkit::contour::{Contour, Seg, Vertex};
+use camkit::contour::{Contour, Seg};
 use camkit::geom::P2;
-use camkit::tol;
-use cavalier_contours::polyline::{PlineCreation, PlineSource, PlineSourceMut, Polyline};
-use cavalier_contours::shape_algorithms::{Shape, ShapeOffsetOptions};
 use std::fmt;
 
 /// Boundary points farther than this (mm) from the opened region are uncut: a micron, well
 /// above the two verified offsets' deviation (2 × `OFFSET_TOL`), well below any rest worth naming.
 pub const UNCUT_TOL: f64 = 1e-3;
-
-/// Epsilons of the shape offset that grows the shrunk loops (equal positions, offset distance
-/// validity), tried in order until one result verifies.
-const GROW_EPS: [(f64, f64); 3] = [(1e-5, 1e-4), (1e-6, 1e-5), (1e-4, 1e-3)];
 
 /// A region opened by ρ: the pieces of one input region that a disk of radius ρ reaches.
 #[derive(Clone, Debug, PartialEq)]
@@ -74,34 +65,12 @@ pub fn open(regions: &[Region], rho: f64) -> Result<Opening, OpenError> {
 /// grown outward by `rho` together, verified.
 fn grow(shrunk: &[Contour], rho: f64) -> Result<Vec<Contour>, OpenError> {
     let input: Vec<&Contour> = shrunk.iter().collect();
-    let shape = Shape::from_plines(shrunk.iter().map(to_pline));
-    let mut last = String::new();
-    for (pos, dist) in GROW_EPS {
-        let o = ShapeOffsetOptions { pos_equal_eps: pos, offset_dist_eps: dist, slice_join_eps: dist.max(pos) };
-        let res = shape.parallel_offset(-rho, &o);
-        let out: Vec<Contour> = res.ccw_plines.iter().chain(&res.cw_plines).map(|p| from_pline(&p.polyline)).collect();
-        match check_offset(&input, &out, rho, Side::Right, true, tol::OFFSET_TOL) {
-            Ok(_) if !out.is_empty() => return Ok(out),
-            Ok(_) => last = "no loop".into(),
-            Err(d) => last = d.describe(),
-        }
+    let grown = grow_region(&input, rho, &OffsetOptions::default())
+        .map_err(|e| OpenError(format!("growing by {rho} mm: {e}")))?;
+    if grown.contours.is_empty() {
+        return Err(OpenError(format!("growing by {rho} mm: no loop")));
     }
-    Err(OpenError(format!("growing by {rho} mm: no verified offset: {last}")))
-}
-
-fn to_pline(c: &Contour) -> Polyline<f64> {
-    let mut p = Polyline::with_capacity(c.vertices.len(), c.closed);
-    for v in &c.vertices {
-        p.add(v.p.x, v.p.y, v.bulge);
-    }
-    p
-}
-
-fn from_pline(p: &Polyline<f64>) -> Contour {
-    Contour {
-        vertices: p.iter_vertexes().map(|v| Vertex { p: P2::new(v.x, v.y), bulge: v.bulge }).collect(),
-        closed: p.is_closed(),
-    }
+    Ok(grown.contours)
 }
 
 /// Area of a region (mm²): the boundary's less the islands'.

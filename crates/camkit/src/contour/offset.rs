@@ -297,6 +297,17 @@ pub fn offset_region(region: &Region, d: f64, opts: &OffsetOptions) -> Result<Of
     offset_region_in(region, &RegionPieces::new(region), d, opts)
 }
 
+/// Offsets loops oriented as a region (boundaries counter-clockwise, islands clockwise) outward
+/// by `d` (mm, > 0), all together: boundaries grow, islands shrink, and grown parts that overlap
+/// merge into one loop (the boundary of their union). Verified like every offset here: the
+/// growth of a region shrunk by `d` is its opening (what a disk of radius `d` reaches).
+pub fn grow_region(loops: &[&Contour], d: f64, opts: &OffsetOptions) -> Result<Offset, OffsetError> {
+    let set = SegSet::new(loops.iter().copied());
+    verified_from(&set, loops, loops, d, -1.0, true, opts, false, &[], |source, nudge, eps, _| {
+        shape_offset(source, -(d + nudge), eps)
+    })
+}
+
 /// The pieces of a region's loops, made once for several offsets of it ([`offset_region_in`],
 /// [`RegionPieces::first_empty_level`]).
 pub(crate) struct RegionPieces(SegSet);
@@ -403,6 +414,31 @@ mod tests {
         assert!((outside.contours[0].area() - PI * 12.5 * 12.5).abs() < 1e-9);
         let gone = offset_contour(&c, 10.5, Side::Left, &OffsetOptions::default()).unwrap();
         assert!(gone.contours.is_empty());
+    }
+
+    #[test]
+    fn grow_region_rounds_corners_merges_neighbours_and_shrinks_islands() {
+        let rect = |x0: f64, y0: f64, x1: f64, y1: f64| {
+            Contour::polygon(&[P2::new(x0, y0), P2::new(x1, y0), P2::new(x1, y1), P2::new(x0, y1)], true)
+        };
+        let opts = OffsetOptions::default();
+        // A 10 × 6 rectangle grown by 2: area + perimeter·2 + π·2², one loop.
+        let g = grow_region(&[&rect(0.0, 0.0, 10.0, 6.0)], 2.0, &opts).unwrap();
+        assert_eq!(g.contours.len(), 1);
+        assert!((g.contours[0].area() - (60.0 + 32.0 * 2.0 + PI * 4.0)).abs() < 1e-9);
+        // Two squares 3 apart grown by 2 overlap: one loop around both. An island (clockwise)
+        // of radius 1.5 inside a big square grown by 2 vanishes; one of radius 3 shrinks to 1.
+        let two = grow_region(&[&rect(0.0, 0.0, 4.0, 4.0), &rect(7.0, 0.0, 11.0, 4.0)], 2.0, &opts).unwrap();
+        assert_eq!(two.contours.len(), 1, "{:?}", two.contours.len());
+        let outer = rect(0.0, 0.0, 20.0, 20.0);
+        let hole = |r: f64| Contour::circle(P2::new(10.0, 10.0), r, 0.0, false);
+        let (small, big) = (hole(1.5), hole(3.0));
+        let g = grow_region(&[&outer, &small], 2.0, &opts).unwrap();
+        assert_eq!(g.contours.len(), 1);
+        let g = grow_region(&[&outer, &big], 2.0, &opts).unwrap();
+        assert_eq!(g.contours.len(), 2);
+        let island = g.contours.iter().find(|c| !c.is_ccw()).expect("the island");
+        assert!((island.area().abs() - PI).abs() < 1e-9);
     }
 
     #[test]
