@@ -3,52 +3,140 @@
 must give a verified result (exit 0) or refuse the input naming a crossing (exit 2). Anything
 else (exit 1: no verified offset; a crash) is a defect and its input is kept.
 
-  scripts/fuzz-offset.py [SEEDS] [--spiky]    (offset binary: $OFFSET or target/release/offset)
+  scripts/fuzz-offset.py [SEEDS] [--spiky | --fine | --fillets | --far | --tiny]
+                                             (offset binary: $OFFSET or target/release/offset)
 
 --spiky widens radii and bulges so that many stars fold across themselves (refusals expected).
+--fine splits every piece into up to 30 shorter ones, the line pieces' joints moved off the line by
+up to 1e-4 mm (near-collinear runs). --fillets rounds every corner with a tangent arc (radius
+0.2-3 mm), the tangency broken by up to 1e-6 rad at random joints. --far moves the star to
+x = 1e5, y = -3e4 mm; --tiny scales the star and every radius and step by 1/100.
 """
 import math, os, random, subprocess, sys, tempfile
 
-def star(seed, spiky):
-    rnd = random.Random(seed)
+def arc_centre(a, b, bulge):
+    """Centre of the arc from a to b with this bulge (positive: counter-clockwise)."""
+    c = math.dist(a, b)
+    theta = 4 * math.atan(abs(bulge))
+    h = math.sqrt(max((c / (2 * math.sin(theta / 2))) ** 2 - c * c / 4, 0))
+    s = 1 if bulge > 0 else -1  # a minor ccw arc has its centre on the chord's left
+    return ((a[0] + b[0]) / 2 - s * (b[1] - a[1]) / c * h, (a[1] + b[1]) / 2 + s * (b[0] - a[0]) / c * h)
+
+def star_pieces(rnd, spiky):
+    """The star's outer loop as pieces (a, b, centre or None, ccw)."""
     n = rnd.randint(5, 40)
     lo, hi, bmax = (12, 30, 0.4) if spiky else (22, 30, 0.15)
     pts = []
     for k in range(n):
         r, a = rnd.uniform(lo, hi), 2 * math.pi * k / n
         pts.append((50 + r * math.cos(a), 50 + r * math.sin(a)))
-    rows = ["path,move,x,y,z,xc,yc", f"0,rapid,{pts[0][0]:.6f},{pts[0][1]:.6f},0,,"]
+    pieces = []
     for k in range(n):
         a, b = pts[k], pts[(k + 1) % n]
         if rnd.random() < 0.4:
             bulge = rnd.choice([-1, 1]) * rnd.uniform(0.02, bmax)
-            c = math.dist(a, b)
-            theta = 4 * math.atan(abs(bulge))
-            h = math.sqrt(max((c / (2 * math.sin(theta / 2))) ** 2 - c * c / 4, 0))
-            s = 1 if bulge > 0 else -1  # a minor ccw arc has its centre on the chord's left
-            ox = (a[0] + b[0]) / 2 - s * (b[1] - a[1]) / c * h
-            oy = (a[1] + b[1]) / 2 + s * (b[0] - a[0]) / c * h
-            rows.append(f"0,{'ccw' if bulge > 0 else 'cw'},{b[0]:.6f},{b[1]:.6f},0,{ox:.9f},{oy:.9f}")
+            pieces.append((a, b, arc_centre(a, b, bulge), bulge > 0))
         else:
-            rows.append(f"0,line,{b[0]:.6f},{b[1]:.6f},0,,")
+            pieces.append((a, b, None, True))
+    return pieces
+
+def finer(rnd, pieces):
+    """Each piece split into up to 30, line joints moved off the line by up to 1e-4 mm."""
+    out = []
+    for a, b, c, ccw in pieces:
+        k = rnd.randint(1, 30)
+        if c is None:
+            pts = [a]
+            for j in range(1, k):
+                t, off = j / k, rnd.uniform(-1e-4, 1e-4) * rnd.choice([0, 1e-3, 1])
+                L = math.dist(a, b)
+                nx, ny = -(b[1] - a[1]) / L, (b[0] - a[0]) / L
+                pts.append((a[0] + t * (b[0] - a[0]) + off * nx, a[1] + t * (b[1] - a[1]) + off * ny))
+            pts.append(b)
+            out += [(p, q, None, True) for p, q in zip(pts, pts[1:])]
+        else:
+            r = math.dist(a, c)
+            a0, a1 = math.atan2(a[1] - c[1], a[0] - c[0]), math.atan2(b[1] - c[1], b[0] - c[0])
+            sweep = (a1 - a0) % (2 * math.pi) if ccw else -((a0 - a1) % (2 * math.pi))
+            pts = [a] + [(c[0] + r * math.cos(a0 + sweep * j / k), c[1] + r * math.sin(a0 + sweep * j / k))
+                         for j in range(1, k)] + [b]
+            out += [(p, q, c, ccw) for p, q in zip(pts, pts[1:])]
+    return out
+
+def filleted(rnd, n_min=5):
+    """A star polygon with every corner rounded by a tangent arc, tangency broken at random joints."""
+    while True:
+        n = rnd.randint(n_min, 30)
+        pts = []
+        for k in range(n):
+            r, a = rnd.uniform(18, 30), 2 * math.pi * k / n
+            pts.append((50 + r * math.cos(a), 50 + r * math.sin(a)))
+        pieces, ok = [], True
+        corners = []
+        for k in range(n):
+            p, v, q = pts[k - 1], pts[k], pts[(k + 1) % n]
+            u1 = ((v[0] - p[0]) / math.dist(p, v), (v[1] - p[1]) / math.dist(p, v))
+            u2 = ((q[0] - v[0]) / math.dist(v, q), (q[1] - v[1]) / math.dist(v, q))
+            turn = math.atan2(u1[0] * u2[1] - u1[1] * u2[0], u1[0] * u2[0] + u1[1] * u2[1])
+            rf = rnd.uniform(0.2, 3)
+            t = rf * math.tan(abs(turn) / 2)
+            if t > 0.45 * min(math.dist(p, v), math.dist(v, q)):
+                ok = False
+                break
+            e1 = (v[0] - u1[0] * t, v[1] - u1[1] * t)
+            e2 = (v[0] + u2[0] * t, v[1] + u2[1] * t)
+            s = 1 if turn > 0 else -1
+            c = (e1[0] - s * u1[1] * rf, e1[1] + s * u1[0] * rf)
+            if rnd.random() < 0.3:  # break the tangency by up to 1e-6 rad about the corner
+                w = rnd.uniform(-1e-6, 1e-6)
+                c = (v[0] + (c[0] - v[0]) * math.cos(w) - (c[1] - v[1]) * math.sin(w),
+                     v[1] + (c[0] - v[0]) * math.sin(w) + (c[1] - v[1]) * math.cos(w))
+                r2 = math.dist(c, e1)
+                e2 = (c[0] + (e2[0] - c[0]) * r2 / math.dist(c, e2), c[1] + (e2[1] - c[1]) * r2 / math.dist(c, e2))
+            corners.append((e1, e2, c, turn > 0))
+        if not ok:
+            continue
+        for k in range(n):
+            e1, e2, c, ccw = corners[k]
+            pieces.append((e1, e2, c, ccw))
+            pieces.append((e2, corners[(k + 1) % n][0], None, True))
+        return pieces
+
+def star(seed, family):
+    rnd = random.Random(seed)
+    pieces = filleted(rnd) if family == "fillets" else star_pieces(rnd, family == "spiky")
+    if family == "fine":
+        pieces = finer(rnd, pieces)
+    islands = []
     for i in range(rnd.randint(0, 2)):
-        r, cx, cy = rnd.uniform(1, 4), 50 + rnd.uniform(-6, 6), 50 + rnd.uniform(-6, 6)
-        rows += [f"{i + 1},rapid,{cx + r:.6f},{cy:.6f},0,,", f"{i + 1},cw,{cx - r:.6f},{cy:.6f},0,{cx:.6f},{cy:.6f}",
-                 f"{i + 1},cw,{cx + r:.6f},{cy:.6f},0,{cx:.6f},{cy:.6f}"]
+        islands.append((rnd.uniform(1, 4), 50 + rnd.uniform(-6, 6), 50 + rnd.uniform(-6, 6)))
+    k, (dx, dy) = (0.01, (0, 0)) if family == "tiny" else (1, (1e5, -3e4) if family == "far" else (0, 0))
+    def f(p):
+        return f"{p[0] * k + dx:.9f},{p[1] * k + dy:.9f}"
+    rows = ["path,move,x,y,z,xc,yc", f"0,rapid,{f(pieces[0][0])},0,,"]
+    for a, b, c, ccw in pieces:
+        rows.append(f"0,{'ccw' if ccw else 'cw'},{f(b)},0,{f(c)}" if c else f"0,line,{f(b)},0,,")
+    for i, (r, cx, cy) in enumerate(islands):
+        rows += [f"{i + 1},rapid,{f((cx + r, cy))},0,,", f"{i + 1},cw,{f((cx - r, cy))},0,{f((cx, cy))}",
+                 f"{i + 1},cw,{f((cx + r, cy))},0,{f((cx, cy))}"]
     return "\n".join(rows) + "\n"
 
 def main():
     args = [a for a in sys.argv[1:] if not a.startswith("--")]
-    seeds, spiky = int(args[0]) if args else 100, "--spiky" in sys.argv
+    seeds = int(args[0]) if args else 100
+    families = [f for f in ("spiky", "fine", "fillets", "far", "tiny") if f"--{f}" in sys.argv]
+    family = families[0] if families else "smooth"
+    k = 0.01 if family == "tiny" else 1
     binary = os.environ.get("OFFSET", os.path.join(os.environ.get("CARGO_TARGET_DIR", "target"), "release", "offset"))
-    runs = [["--until-empty", "--radius", r, "--step", s] for r in ("0.7", "1.5", "3", "5") for s in ("0.6", "1.9", "4")]
-    runs += [["--side", side, "--radius", r] for side in ("left", "right") for r in ("0.5", "2", "6")]
+    g = lambda v: f"{v * k:g}"
+    runs = [["--until-empty", "--radius", g(r), "--step", g(s)] for r in (0.7, 1.5, 3, 5) for s in (0.6, 1.9, 4)]
+    runs += [["--side", side, "--radius", g(r)] for side in ("left", "right") for r in (0.5, 2, 6)]
     counts, kept = {"ok": 0, "refused": 0, "defect": 0}, []
     with tempfile.TemporaryDirectory() as tmp:
         src, out = os.path.join(tmp, "star.csv"), os.path.join(tmp, "out.csv")
         for seed in range(1, seeds + 1):
             with open(src, "w") as f:
-                f.write(star(seed, spiky))
+                f.write(star(seed, family))
             for run in runs:
                 p = subprocess.run([binary, src, *run, "-o", out], capture_output=True, text=True)
                 if p.returncode == 0:
@@ -58,7 +146,7 @@ def main():
                 else:
                     counts["defect"] += 1
                     kept.append(f"seed {seed} {' '.join(run)}: exit {p.returncode}: {p.stderr.strip()[:200]}")
-    print(f"{seeds} stars ({'spiky' if spiky else 'smooth'}), {sum(counts.values())} runs: {counts}")
+    print(f"{seeds} stars ({family}), {sum(counts.values())} runs: {counts}")
     for k in kept[:20]:
         print(k)
     sys.exit(1 if kept else 0)
