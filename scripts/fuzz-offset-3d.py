@@ -8,13 +8,10 @@ distance R to R + 1 um (the chord tolerance) from the polygon in that plane, on 
 """
 import csv, math, os, random, subprocess, sys
 
-B = os.environ.get("OFFSET", os.path.join(os.environ.get("CARGO_TARGET_DIR", "target"), "release", "offset"))
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from fuzzkit import binary, finish, scratch, seg_dist  # noqa: E402
 
-def seg_dist(p, a, b):
-    d = (b[0] - a[0], b[1] - a[1])
-    L2 = d[0] ** 2 + d[1] ** 2
-    t = max(0, min(1, ((p[0] - a[0]) * d[0] + (p[1] - a[1]) * d[1]) / L2)) if L2 else 0
-    return math.dist(p, (a[0] + t * d[0], a[1] + t * d[1]))
+B = binary("offset")
 
 def inside(p, poly):
     c = False
@@ -25,8 +22,7 @@ def inside(p, poly):
 
 def main():
     seeds = int(sys.argv[1]) if len(sys.argv) > 1 else 100
-    tmp = os.environ.get("TMPDIR", "/tmp")
-    src, out = os.path.join(tmp, f"fuzz3d-{os.getpid()}.csv"), os.path.join(tmp, f"fuzz3d-{os.getpid()}-out.csv")
+    src, out = scratch("fuzz3d")
     counts, bad, worst = {}, [], 0.0
     for seed in range(1, seeds + 1):
         rnd = random.Random(seed)
@@ -67,12 +63,6 @@ def main():
                         bad.append(f"seed {seed} {side} R {R}: ({u:.4f}, {v:.4f}) at {d}, {off:.2e} off the plane, "
                                    f"wrong side {wrong}")
                         break
-    for f in (src, out):
-        if os.path.exists(f):
-            os.remove(f)
-    print(f"{seeds} stars, exit statuses {counts}, largest deviation {worst:.2e} mm")
-    for b in bad[:15]:
-        print(b)
-    sys.exit(1 if bad else 0)
+    finish((src, out), f"{seeds} stars, exit statuses {counts}, largest deviation {worst:.2e} mm", bad)
 
 main()

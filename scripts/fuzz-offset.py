@@ -14,13 +14,8 @@ x = 1e5, y = -3e4 mm; --tiny scales the star and every radius and step by 1/100.
 """
 import math, os, random, subprocess, sys, tempfile
 
-def arc_centre(a, b, bulge):
-    """Centre of the arc from a to b with this bulge (positive: counter-clockwise)."""
-    c = math.dist(a, b)
-    theta = 4 * math.atan(abs(bulge))
-    h = math.sqrt(max((c / (2 * math.sin(theta / 2))) ** 2 - c * c / 4, 0))
-    s = 1 if bulge > 0 else -1  # a minor ccw arc has its centre on the chord's left
-    return ((a[0] + b[0]) / 2 - s * (b[1] - a[1]) / c * h, (a[1] + b[1]) / 2 + s * (b[0] - a[0]) / c * h)
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from fuzzkit import arc_centre, binary  # noqa: E402
 
 def star_pieces(rnd, spiky):
     """The star's outer loop as pieces (a, b, centre or None, ccw)."""
@@ -127,7 +122,7 @@ def main():
     families = [f for f in ("spiky", "fine", "fillets", "far", "tiny") if f"--{f}" in sys.argv]
     family = families[0] if families else "smooth"
     k = 0.01 if family == "tiny" else 1
-    binary = os.environ.get("OFFSET", os.path.join(os.environ.get("CARGO_TARGET_DIR", "target"), "release", "offset"))
+    offset = binary("offset")
     g = lambda v: f"{v * k:g}"
     runs = [["--until-empty", "--radius", g(r), "--step", g(s)] for r in (0.7, 1.5, 3, 5) for s in (0.6, 1.9, 4)]
     runs += [["--side", side, "--radius", g(r)] for side in ("left", "right") for r in (0.5, 2, 6)]
@@ -138,7 +133,7 @@ def main():
             with open(src, "w") as f:
                 f.write(star(seed, family))
             for run in runs:
-                p = subprocess.run([binary, src, *run, "-o", out], capture_output=True, text=True)
+                p = subprocess.run([offset, src, *run, "-o", out], capture_output=True, text=True)
                 if p.returncode == 0:
                     counts["ok"] += 1
                 elif p.returncode == 2 and "cross" in p.stderr:

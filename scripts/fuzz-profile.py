@@ -12,15 +12,10 @@ Deviations over 1e-6 mm are defects.
 """
 import csv, io, math, os, random, subprocess, sys
 
-B = os.environ.get("OFFSET", os.path.join(os.environ.get("CARGO_TARGET_DIR", "target"), "release", "offset"))
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from fuzzkit import arc_centre, binary, finish, scratch, seg_dist  # noqa: E402
 
-def arc_centre(a, b, bulge):
-    """Centre of the arc from a to b with this bulge (positive: counter-clockwise)."""
-    c = math.dist(a, b)
-    theta = 4 * math.atan(abs(bulge))
-    h = math.sqrt(max((c / (2 * math.sin(theta / 2))) ** 2 - c * c / 4, 0))
-    s = 1 if bulge > 0 else -1
-    return ((a[0] + b[0]) / 2 - s * (b[1] - a[1]) / c * h, (a[1] + b[1]) / 2 + s * (b[0] - a[0]) / c * h)
+B = binary("offset")
 
 def arc_params(a, b, c, ccw):
     """Radius, start angle and signed sweep of the arc from a to b about c."""
@@ -71,10 +66,7 @@ def square_tip(pieces, x, R):
 def dist_piece(p, a, b, c, ccw):
     """Distance from p to a line (c None) or arc piece."""
     if c is None:
-        d = (b[0] - a[0], b[1] - a[1])
-        L2 = d[0] ** 2 + d[1] ** 2
-        t = max(0, min(1, ((p[0] - a[0]) * d[0] + (p[1] - a[1]) * d[1]) / L2))
-        return math.dist(p, (a[0] + t * d[0], a[1] + t * d[1]))
+        return seg_dist(p, a, b)
     r, a0, sw = arc_params(a, b, c, ccw)
     phi = math.atan2(p[1] - c[1], p[0] - c[0])
     if spans(a0, sw, phi):
@@ -99,8 +91,7 @@ def tip_points(text):
 
 counts, bad, worst = {}, [], {"ball": 0.0, "square": 0.0}
 seeds = int(sys.argv[1]) if len(sys.argv) > 1 else 100
-tmp = os.environ.get("TMPDIR", "/tmp")
-src, out = os.path.join(tmp, f"fuzz-profile-{os.getpid()}.csv"), os.path.join(tmp, f"fuzz-profile-{os.getpid()}-out.csv")
+src, out = scratch("fuzz-profile")
 for seed in range(1, seeds + 1):
     rnd = random.Random(seed)
     n = rnd.randint(2, 30)
@@ -139,10 +130,5 @@ for seed in range(1, seeds + 1):
                 if err > 1e-6:
                     bad.append(f"seed {seed} {tool} {R}: tip at {q} off by {err:.3g}")
                     break
-for f in (src, out):
-    if os.path.exists(f):
-        os.remove(f)
-print(f"{seeds} profiles, exit statuses {counts}, largest deviation {', '.join(f'{k} {v:.2e} mm' for k, v in worst.items())}")
-for b in bad[:15]:
-    print(b)
-sys.exit(1 if bad else 0)
+finish((src, out), f"{seeds} profiles, exit statuses {counts}, largest deviation "
+       + ", ".join(f"{k} {v:.2e} mm" for k, v in worst.items()), bad)
