@@ -9,16 +9,9 @@ distance R to R + 1 um (the chord tolerance) from the polygon in that plane, on 
 import csv, math, os, random, subprocess, sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from fuzzkit import binary, finish, scratch, seg_dist  # noqa: E402
+from fuzzkit import binary, finish, inside, scratch, seg_dist  # noqa: E402
 
 B = binary("offset")
-
-def inside(p, poly):
-    c = False
-    for (x1, y1), (x2, y2) in zip(poly, poly[1:] + poly[:1]):
-        if (y1 > p[1]) != (y2 > p[1]) and p[0] < x1 + (p[1] - y1) * (x2 - x1) / (y2 - y1):
-            c = not c
-    return c
 
 def main():
     seeds = int(sys.argv[1]) if len(sys.argv) > 1 else 100

@@ -27,6 +27,14 @@ def seg_dist(p, a, b):
     t = max(0, min(1, ((p[0] - a[0]) * d[0] + (p[1] - a[1]) * d[1]) / L2)) if L2 else 0
     return math.dist(p, (a[0] + t * d[0], a[1] + t * d[1]))
 
+def inside(p, poly):
+    """True if point p is inside the polygon poly (a list of points, closed implicitly)."""
+    c = False
+    for (x1, y1), (x2, y2) in zip(poly, poly[1:] + poly[:1]):
+        if (y1 > p[1]) != (y2 > p[1]) and p[0] < x1 + (p[1] - y1) * (x2 - x1) / (y2 - y1):
+            c = not c
+    return c
+
 def finish(files, summary, bad):
     """Removes the scratch files, prints the summary and the first defects, exits 1 if any."""
     for f in files:
