@@ -7,7 +7,8 @@ else (exit 1: no verified offset; a crash) is a defect and its input is kept.
                                              (offset binary: $OFFSET or target/release/offset)
 
 --spiky widens radii and bulges so that many stars fold across themselves (refusals expected).
---fine splits every piece into up to 30 shorter ones, the line pieces' joints moved off the line by
+--open offsets random walks of lines and arcs (open paths) on both sides, with and without
+--allow-self-crossing (with it, every run must verify). --fine splits every piece into up to 30 shorter ones, the line pieces' joints moved off the line by
 up to 1e-4 mm (near-collinear runs). --fillets rounds every corner with a tangent arc (radius
 0.2-3 mm), the tangency broken by up to 1e-6 rad at random joints. --far moves the star to
 x = 1e5, y = -3e4 mm; --tiny scales the star and every radius and step by 1/100.
@@ -97,6 +98,24 @@ def filleted(rnd, n_min=5):
             pieces.append((e2, corners[(k + 1) % n][0], None, True))
         return pieces
 
+def walk(seed):
+    """An open path: a random walk of 3-26 lines and arcs (bulges up to 0.9), often crossing itself."""
+    rnd = random.Random(seed)
+    pts, ang = [(0.0, 0.0)], 0.0
+    for _ in range(rnd.randint(2, 25)):
+        ang += rnd.uniform(-2.0, 2.0)
+        step = rnd.uniform(0.5, 15)
+        pts.append((pts[-1][0] + step * math.cos(ang), pts[-1][1] + step * math.sin(ang)))
+    rows = ["path,move,x,y,z,xc,yc", f"0,rapid,{pts[0][0]!r},{pts[0][1]!r},0,,"]
+    for a, b in zip(pts, pts[1:]):
+        if rnd.random() < 0.4:
+            bulge = rnd.choice([-1, 1]) * rnd.uniform(0.02, 0.9)
+            c = arc_centre(a, b, bulge)
+            rows.append(f"0,{'ccw' if bulge > 0 else 'cw'},{b[0]!r},{b[1]!r},0,{c[0]!r},{c[1]!r}")
+        else:
+            rows.append(f"0,line,{b[0]!r},{b[1]!r},0,,")
+    return "\n".join(rows) + "\n"
+
 def star(seed, family):
     rnd = random.Random(seed)
     pieces = filleted(rnd) if family == "fillets" else star_pieces(rnd, family == "spiky")
@@ -119,24 +138,28 @@ def star(seed, family):
 def main():
     args = [a for a in sys.argv[1:] if not a.startswith("--")]
     seeds = int(args[0]) if args else 100
-    families = [f for f in ("spiky", "fine", "fillets", "far", "tiny") if f"--{f}" in sys.argv]
+    families = [f for f in ("spiky", "fine", "fillets", "far", "tiny", "open") if f"--{f}" in sys.argv]
     family = families[0] if families else "smooth"
     k = 0.01 if family == "tiny" else 1
     offset = binary("offset")
     g = lambda v: f"{v * k:g}"
     runs = [["--until-empty", "--radius", g(r), "--step", g(s)] for r in (0.7, 1.5, 3, 5) for s in (0.6, 1.9, 4)]
     runs += [["--side", side, "--radius", g(r)] for side in ("left", "right") for r in (0.5, 2, 6)]
+    if family == "open":
+        # Open paths: both sides, with and without accepting a crossing (then it must verify).
+        runs = [["--side", side, "--radius", str(r), *extra]
+                for side in ("left", "right") for r in (0.3, 2, 7) for extra in ([], ["--allow-self-crossing"])]
     counts, kept = {"ok": 0, "refused": 0, "defect": 0}, []
     with tempfile.TemporaryDirectory() as tmp:
         src, out = os.path.join(tmp, "star.csv"), os.path.join(tmp, "out.csv")
         for seed in range(1, seeds + 1):
             with open(src, "w") as f:
-                f.write(star(seed, family))
+                f.write(walk(seed) if family == "open" else star(seed, family))
             for run in runs:
                 p = subprocess.run([offset, src, *run, "-o", out], capture_output=True, text=True)
                 if p.returncode == 0:
                     counts["ok"] += 1
-                elif p.returncode == 2 and "cross" in p.stderr:
+                elif p.returncode == 2 and "cross" in p.stderr and "--allow-self-crossing" not in run:
                     counts["refused"] += 1
                 else:
                     counts["defect"] += 1
