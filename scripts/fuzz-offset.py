@@ -3,13 +3,13 @@
 must give a verified result (exit 0) or refuse the input naming a crossing (exit 2). Anything
 else (exit 1: no verified offset; a crash) is a defect and its input is kept.
 
-  scripts/fuzz-offset.py [SEEDS] [--spiky | --fine | --fillets | --far | --tiny]
+  scripts/fuzz-offset.py [SEEDS] [--spiky | --fine | --fillets | --far | --tiny | --open]
                                              (offset binary: $OFFSET or target/release/offset)
 
 --spiky widens radii and bulges so that many stars fold across themselves (refusals expected).
 --open offsets random walks of lines and arcs (open paths) on both sides, with and without
---allow-self-crossing (with it, every run must verify). --fine splits every piece into up to 30 shorter ones, the line pieces' joints moved off the line by
-up to 1e-4 mm (near-collinear runs). --fillets rounds every corner with a tangent arc (radius
+--allow-self-crossing (with it, every run must verify). --fine splits every piece into up to 30
+shorter ones, the line pieces' joints moved off the line by up to 1e-4 mm (near-collinear runs). --fillets rounds every corner with a tangent arc (radius
 0.2-3 mm), the tangency broken by up to 1e-6 rad at random joints. --far moves the star to
 x = 1e5, y = -3e4 mm; --tiny scales the star and every radius and step by 1/100.
 """
