@@ -116,7 +116,8 @@ fn bad_input_is_refused_with_its_place() {
     w.write("cross.csv", cross);
     w.run(BIN, &["cross.csv", "--radius", "1"], b"").fails(2, "cross.csv:2");
     let sq = data("medial-trochoid/square.csv");
-    w.run(BIN, &[sq.to_str().unwrap(), "--radius", "30"], b"").fails(2, "does not fit");
+    // A tool too large names the pocket's boundary by its first row (line 3 of square.csv).
+    w.run(BIN, &[sq.to_str().unwrap(), "--radius", "30"], b"").fails(2, "square.csv:3: path 1: the tool does not fit");
     w.run(BIN, &[sq.to_str().unwrap(), "--radius", "-1"], b"").fails(2, "--radius");
     // DXF: a contour that does not close, and a bad number, named with their line.
     let line = |a: (i32, i32), b: (i32, i32)| format!("0\nLINE\n10\n{}\n20\n{}\n11\n{}\n21\n{}\n", a.0, a.1, b.0, b.1);
@@ -349,7 +350,14 @@ fn material_no_loop_can_clear_is_named_when_the_threshold_is_not_held() {
     let refused = w.run(BIN, &args, b"");
     assert_eq!(refused.status, 1, "{}", refused.stderr);
     assert!(refused.stderr.contains("--allow-over-threshold"), "{}", refused.stderr);
+    assert!(!refused.stderr.contains("side-cuts"), "{}", refused.stderr);
     assert!(!w.path("t.csv").exists());
+    // A step over whose straight side cut is over the threshold (0.6 R: acos 0.4 = 66.42°)
+    // cannot hold it: the refusal names that cause and the largest step that holds.
+    let step = w.run(BIN, &[&args[..], &["--step", "3"]].concat(), b"");
+    assert_eq!(step.status, 1, "{}", step.stderr);
+    let why = "--step 3 mm side-cuts straight walls at 66.422°, at most R(1 − cos threshold) = 1.1698 mm holds";
+    assert!(step.stderr.contains(why), "{}", step.stderr);
     assert_eq!(report(&w, "r.json")["threshold_held"], false);
     let run = w.run(BIN, &[&args[..], &["--allow-over-threshold"]].concat(), b"");
     run.ok();

@@ -164,6 +164,13 @@ pub const OPENING_LADDER: [f64; 5] = [1.1, 1.25, 1.5, 2.0, 3.0];
 /// line meets the previous pass's band tangentially).
 pub const ENGAGEMENT_ROUNDOFF_DEG: f64 = 1e-5;
 
+/// Engagement of a straight side cut at radial depth `step` with a tool of radius `r`
+/// (degrees): acos(1 − step/R), 180° from a step of 2R on. Passes that follow one another at
+/// this step cannot hold a lower threshold on straight walls.
+pub fn side_cut_deg(r: f64, step: f64) -> f64 {
+    (1.0 - step / r).clamp(-1.0, 1.0).acos().to_degrees()
+}
+
 /// Most links over the threshold a plan replaces (each takes a re-simulation of the program).
 const RELINK_ROUNDS: usize = 16;
 
@@ -885,5 +892,16 @@ mod tests {
         assert_eq!(pieces[2].0, vec![P2::new(6.0, 0.0), P2::new(5.0, 0.0)]);
         assert_eq!(spans(&[true, true, false, true], |f| f), vec![(0, 2), (3, 4)]);
         assert!((SMALLEST_LOOP - LEVEL_RATIO.powi(LEVELS as i32 - 1)).abs() < 1e-15);
+    }
+
+    #[test]
+    fn side_cut_is_the_closed_form_and_the_default_step_meets_the_threshold() {
+        // The step over R(1 − cos θ) side-cuts at θ; 0.6 R at acos(0.4) = 66.42°; 2R and more: a slot.
+        for theta in [30.0f64, 40.0] {
+            assert!((side_cut_deg(5.0, 5.0 * (1.0 - theta.to_radians().cos())) - theta).abs() < 1e-9);
+        }
+        assert!((side_cut_deg(2.0, 1.2) - 0.4f64.acos().to_degrees()).abs() < 1e-12);
+        assert_eq!(side_cut_deg(2.0, 4.0), 180.0);
+        assert_eq!(side_cut_deg(2.0, 5.0), 180.0);
     }
 }

@@ -246,6 +246,12 @@ fn run(args: Args) -> Result<()> {
     let planned = if leave_uncut { plan_leaving_uncut(&regions, &settings) } else { plan(&regions, &settings) };
     let plan = planned.map_err(|e| match e {
         medial_trochoid::PlanError::Pocket(_) => Error::check(e.to_string()),
+        // The tool fits no region: name the first region's boundary, where the pocket starts.
+        medial_trochoid::PlanError::NoPasses => {
+            let outer = &sources[regions[0].outer_source];
+            Error::input(format!("path {}: {e} (R + allowance = {} mm)", outer.path, r + args.allowance))
+                .at(Location::file(&name).line(outer.line))
+        }
         _ => Error::input(e.to_string()).at(Location::file(&name)),
     })?;
     let chosen = if args.program == Which::Trochoid { &plan.trochoidal } else { &plan.offset_only };
@@ -266,8 +272,19 @@ fn run(args: Args) -> Result<()> {
             (Some(a), Some(b)) => format!(" (nor did the pocket opened by {a:.3} to {b:.3} mm, to leave uncut what the tool cannot reach)"),
             _ => String::new(),
         };
+        // A step whose straight side cut is over the threshold cannot hold it wherever a pass
+        // follows another: say so, it is the likely cause.
+        let side_cut = medial_trochoid::side_cut_deg(r, step);
+        let hint = if side_cut > threshold + medial_trochoid::ENGAGEMENT_ROUNDOFF_DEG {
+            format!(
+                "; --step {step} mm side-cuts straight walls at {side_cut:.3}°, at most R(1 − cos threshold) = {:.4} mm holds the threshold",
+                r * (1.0 - threshold.to_radians().cos())
+            )
+        } else {
+            String::new()
+        };
         format!(
-            "{} samples still over the threshold after {} repair rounds{openings} (the worst {e:.3}° at ({:.3}, {:.3})): listed in the report",
+            "{} samples still over the threshold after {} repair rounds{openings} (the worst {e:.3}° at ({:.3}, {:.3})): listed in the report{hint}",
             plan.left_over.len(),
             plan.repair_rounds,
             p.x,
