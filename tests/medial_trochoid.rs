@@ -386,8 +386,11 @@ fn fillet_area(alpha: f64, rho: f64) -> f64 {
     rho * rho * (1.0 / (0.5 * alpha).tan() - 0.5 * (std::f64::consts::PI - alpha))
 }
 
-/// The uncut stretches of report `r` as (loop, thickness, thickest point, from, to).
-fn uncut(r: &serde_json::Value) -> Vec<(i64, f64, (f64, f64), (f64, f64), (f64, f64))> {
+/// An uncut stretch of a report: (loop, thickness, thickest point, from, to).
+type Stretch = (i64, f64, (f64, f64), (f64, f64), (f64, f64));
+
+/// The uncut stretches of report `r`.
+fn uncut(r: &serde_json::Value) -> Vec<Stretch> {
     let xy = |v: &serde_json::Value| (v[0].as_f64().unwrap(), v[1].as_f64().unwrap());
     r["uncut"]
         .as_array()
