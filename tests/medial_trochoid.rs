@@ -552,6 +552,23 @@ fn box_die_gaps_beside_the_boss_are_left_uncut_at_r6_and_r5_is_unchanged() {
 }
 
 #[test]
+fn a_tool_that_cuts_nothing_under_the_threshold_is_too_large() {
+    // A U slot 5.27 mm wide (found by scripts/fuzz-trochoid.py): an R3 tool fits only its two
+    // bends, and there it slots. The opening by 1.1 R is empty, so leaving uncut what the tool
+    // cannot reach would leave all of it: bad input, named by the boundary's first row (line 3).
+    let w = Work::new();
+    let src = data("medial-trochoid/u-slot.csv");
+    let args = [src.to_str().unwrap(), "--radius", "3", "--threshold", "30", "-o", "t.csv"];
+    w.run(BIN, &args, b"")
+        .fails(2, "u-slot.csv:3: path 1: the tool is too large to cut any of the pocket under the threshold");
+    assert!(!w.path("t.csv").exists());
+    // With --no-leave-uncut the program of the whole slot is a failed check, as before.
+    let refused = w.run(BIN, &[&args[..], &["--no-leave-uncut"]].concat(), b"");
+    assert_eq!(refused.status, 1, "{}", refused.stderr);
+    assert!(refused.stderr.contains("180.000°"), "{}", refused.stderr);
+}
+
+#[test]
 fn a_pocket_no_opening_makes_hold_is_still_refused() {
     // A step of 3 mm at R5: every side cut engages acos(1 − 3/5) = 66.4°, so no opening of the
     // pocket holds 40°: the refusal stays (exit 1, no program), naming the radii tried.

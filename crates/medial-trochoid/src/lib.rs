@@ -206,6 +206,9 @@ pub enum PlanError {
     Medial(String),
     /// No pitch keeps the trochoids under the threshold with this loop radius.
     NoPitch,
+    /// Leaving uncut what the tool cannot reach under the threshold would leave all of it:
+    /// the smaller openings do not hold and a disk of this radius (mm) fits nowhere.
+    TooLarge(f64),
 }
 
 impl std::fmt::Display for PlanError {
@@ -217,6 +220,10 @@ impl std::fmt::Display for PlanError {
             PlanError::NoPitch => write!(
                 f,
                 "no trochoid pitch keeps the engagement under the threshold: use a smaller --trochoid-radius or a larger --threshold"
+            ),
+            PlanError::TooLarge(rho) => write!(
+                f,
+                "the tool is too large to cut any of the pocket under the threshold: wherever it fits it engages more than that, and a disk of radius {rho:.3} mm (the opening that would leave the rest uncut) fits nowhere"
             ),
         }
     }
@@ -323,7 +330,8 @@ pub fn plan(regions: &[Region], s: &Settings) -> Result<Plan, PlanError> {
 /// opened by the first radius of [`OPENING_LADDER`] whose plan holds it: the material the
 /// opening drops is left uncut and named ([`Plan::uncut`]). Both programs (offset-only and
 /// trochoids-first) are then made in the opened regions, so their times compare like with
-/// like; the gouge check stays against `regions`. If no opening holds, the plan of `regions`.
+/// like; the gouge check stays against `regions`. If no opening holds, the plan of `regions`;
+/// if an opening leaves nothing before one holds, [`PlanError::TooLarge`]: all would be uncut.
 pub fn plan_leaving_uncut(regions: &[Region], s: &Settings) -> Result<Plan, PlanError> {
     let mut full = plan(regions, s)?;
     if full.left_over.is_empty() {
@@ -338,8 +346,9 @@ pub fn plan_leaving_uncut(regions: &[Region], s: &Settings) -> Result<Plan, Plan
             continue;
         };
         if opening.regions.is_empty() {
-            // Nothing is left to cut at this radius, nor at a larger one.
-            break;
+            // Nothing is left to cut at this radius, nor at a larger one, and no smaller one
+            // held: the tool cuts nothing of this pocket under the threshold.
+            return Err(PlanError::TooLarge(rho));
         }
         match plan_in(&opening.regions, regions, s) {
             Ok(mut p) if p.left_over.is_empty() => {

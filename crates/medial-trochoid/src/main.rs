@@ -246,8 +246,9 @@ fn run(args: Args) -> Result<()> {
     let planned = if leave_uncut { plan_leaving_uncut(&regions, &settings) } else { plan(&regions, &settings) };
     let plan = planned.map_err(|e| match e {
         medial_trochoid::PlanError::Pocket(_) => Error::check(e.to_string()),
-        // The tool fits no region: name the first region's boundary, where the pocket starts.
-        medial_trochoid::PlanError::NoPasses => {
+        // The tool fits no region, or cuts none of it under the threshold: name the first
+        // region's boundary, where the pocket starts.
+        medial_trochoid::PlanError::NoPasses | medial_trochoid::PlanError::TooLarge(_) => {
             let outer = &sources[regions[0].outer_source];
             Error::input(format!("path {}: {e} (R + allowance = {} mm)", outer.path, r + args.allowance))
                 .at(Location::file(&name).line(outer.line))
