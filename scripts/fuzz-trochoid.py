@@ -6,6 +6,7 @@ threshold_held, more than one stderr line on refusal, a failed check below) is a
 pocket is kept in --keep DIR (default /tmp/fuzz-trochoid-kept).
 
   scripts/fuzz-trochoid.py [SEEDS] [--family star|rect|slot|sharp|all] [--first N] [--jobs J] [--keep DIR]
+                          [--minutes M]   (no pocket is started after M minutes; the summary covers those run)
                                   (binary: $TROCHOID or $CARGO_TARGET_DIR/release/medial-trochoid)
 
 Families: star (stars of lines and arcs, radii 15-24 mm, 0-2 round islands), rect (unions of grid cells, x-monotone,
@@ -20,7 +21,7 @@ point-arc distances, islands included) and inside the pocket; the report's large
 on trochoid and contour rows; every uncut stretch's from/to on the loop it names (1e-6 mm) and
 0 <= uncut_area_mm2 < the pocket's area.
 """
-import csv, json, math, os, random, re, shutil, subprocess, sys, tempfile
+import csv, json, math, os, random, re, shutil, subprocess, sys, tempfile, time
 from concurrent.futures import ThreadPoolExecutor
 
 BIN = os.environ.get("TROCHOID", os.path.join(os.environ.get("CARGO_TARGET_DIR", "target"), "release",
@@ -355,12 +356,13 @@ def main():
     argv = sys.argv[1:]
     opt = lambda k, d: argv[argv.index(k) + 1] if k in argv else d
     pos = [a for i, a in enumerate(argv) if not a.startswith("--") and (i == 0 or argv[i - 1] not in
-                                                                         ("--family", "--first", "--jobs", "--keep"))]
+                                                                         ("--family", "--first", "--jobs", "--keep", "--minutes"))]
     seeds = int(pos[0]) if pos else 40
     fam = opt("--family", "all")
     first = int(opt("--first", "1"))
     jobs = int(opt("--jobs", "1"))
     keep = opt("--keep", "/tmp/fuzz-trochoid-kept")
+    deadline = time.time() + 60 * float(opt("--minutes", "1e9"))
     fams = list(FAMILIES) if fam == "all" else [fam]
     counts, kept = {"exit0": 0, "exit2": 0, "defect": 0}, []
     stats = {"shortfall": -1e9, "on_loop": 0.0, "uncut_runs": 0}
@@ -372,6 +374,8 @@ def main():
 
     def do(case):
         f, seed = case
+        if time.time() > deadline:
+            return f, seed, None, []
         rnd = random.Random(f"{f}-{seed}")
         text = table(FAMILIES[f](rnd))
         src = os.path.join(tmp, f"{f}-{seed}.csv")
@@ -402,7 +406,9 @@ def main():
         return f, seed, text, res
 
     with ThreadPoolExecutor(max_workers=jobs) as ex:
+        done = 0
         for f, seed, text, res in ex.map(do, cases):
+            done += text is not None
             for run, code, why, args in res:
                 if why:
                     counts["defect"] += 1
@@ -415,22 +421,22 @@ def main():
                     with open(name, "w") as fh:
                         fh.write(text)
                     kept.append(f"{name} {' '.join(args)}: {why}")
+                    print(kept[-1], flush=True)
                 elif code == 0:
                     counts["exit0"] += 1
                     per_family[f][0] += 1
                 else:
                     counts["exit2"] += 1
                     per_family[f][1] += 1
-            print(f"{f} {seed}: " + " ".join(str(c) if not w else f"{c}!" for _, c, w, _ in res), file=sys.stderr,
-                  flush=True)
+            if text is not None:
+                print(f"{f} {seed}: " + " ".join(str(c) if not w else f"{c}!" for _, c, w, _ in res) +
+                      f" (shortfall so far {stats['shortfall']:.3g} mm)", file=sys.stderr, flush=True)
     shutil.rmtree(tmp)
-    print(f"{len(cases)} pockets ({', '.join(fams)}), {sum(counts.values())} runs: {counts}")
+    print(f"{done} pockets ({', '.join(fams)}), {sum(counts.values())} runs: {counts}")
     print(f"defects by cause: {causes}")
     print("per family (exit0, exit2, defect): " + ", ".join(f"{f} {v}" for f, v in per_family.items()))
     print(f"largest wall-clearance shortfall (R + allowance - distance, negative = clear): {stats['shortfall']:.3g} mm;"
           f" uncut from/to off their loop by at most {stats['on_loop']:.3g} mm over {stats['uncut_runs']} runs leaving uncut")
-    for k in kept:
-        print(k)
     sys.exit(1 if kept else 0)
 
 
