@@ -24,33 +24,19 @@ on trochoid and contour rows; every uncut stretch's from/to on the loop it names
 import csv, json, math, os, random, re, shutil, subprocess, sys, tempfile, time
 from concurrent.futures import ThreadPoolExecutor
 
-BIN = os.environ.get("TROCHOID", os.path.join(os.environ.get("CARGO_TARGET_DIR", "target"), "release",
-                                               "medial-trochoid"))
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from fuzzkit import arc_centre, binary, inside, seg_dist  # noqa: E402
+
+BIN = os.environ.get("TROCHOID", binary("medial-trochoid"))
 CLEAR_TOL, ENG_TOL, ON_LOOP_TOL = 1e-6, 1e-5, 1e-6
 
 
 # ---------------------------------------------------------------- geometry of the input loops
 # A loop is a list of pieces (a, b, centre or None, ccw).
 
-def arc_centre(a, b, bulge):
-    """Centre of the arc from a to b with this bulge (positive: counter-clockwise)."""
-    c = math.dist(a, b)
-    theta = 4 * math.atan(abs(bulge))
-    h = math.sqrt(max((c / (2 * math.sin(theta / 2))) ** 2 - c * c / 4, 0))
-    s = 1 if bulge > 0 else -1
-    return ((a[0] + b[0]) / 2 - s * (b[1] - a[1]) / c * h, (a[1] + b[1]) / 2 + s * (b[0] - a[0]) / c * h)
-
-
 def sweep_of(a, b, c, ccw):
     a0, a1 = math.atan2(a[1] - c[1], a[0] - c[0]), math.atan2(b[1] - c[1], b[0] - c[0])
     return a0, ((a1 - a0) % (2 * math.pi) if ccw else -((a0 - a1) % (2 * math.pi)))
-
-
-def seg_dist(p, a, b):
-    d = (b[0] - a[0], b[1] - a[1])
-    L2 = d[0] ** 2 + d[1] ** 2
-    t = max(0, min(1, ((p[0] - a[0]) * d[0] + (p[1] - a[1]) * d[1]) / L2)) if L2 else 0
-    return math.dist(p, (a[0] + t * d[0], a[1] + t * d[1]))
 
 
 def arc_dist(p, a, b, c, ccw):
@@ -81,14 +67,6 @@ def flatten(loop, sag=1e-3):
             n = max(2, int(abs(sw) / (2 * math.acos(max(-1, 1 - sag / r)))) + 1)
             pts += [(c[0] + r * math.cos(a0 + sw * k / n), c[1] + r * math.sin(a0 + sw * k / n)) for k in range(1, n)]
     return pts
-
-
-def inside(p, poly):
-    c = False
-    for (x1, y1), (x2, y2) in zip(poly, poly[1:] + poly[:1]):
-        if (y1 > p[1]) != (y2 > p[1]) and p[0] < x1 + (p[1] - y1) * (x2 - x1) / (y2 - y1):
-            c = not c
-    return c
 
 
 def loop_area(loop):
