@@ -144,25 +144,28 @@ fn window(pts: &[P3], closed: bool, i: usize, w: f64) -> (Vec<usize>, bool) {
     (out, whole)
 }
 
+/// The pieces of the window polyline `poly`, with the closing one if `closed`.
+fn pieces(poly: &[P2], closed: bool) -> impl Iterator<Item = (P2, P2)> + '_ {
+    let close = (closed && poly.len() > 2).then(|| (poly[poly.len() - 1], poly[0]));
+    poly.windows(2).map(|w| (w[0], w[1])).chain(close)
+}
+
 /// Smallest distance from the move `a`–`b` to the polyline `poly` (closed if `closed`).
 fn move_distance(a: &P2, b: &P2, poly: &[P2], closed: bool) -> f64 {
-    let d = poly
-        .windows(2)
-        .map(|w| camkit::geom::dist::segment_segment_min(a, b, &w[0], &w[1]))
-        .fold(f64::INFINITY, f64::min);
-    match (closed && poly.len() > 2, poly.first(), poly.last()) {
-        (true, Some(f), Some(l)) => d.min(camkit::geom::dist::segment_segment_min(a, b, l, f)),
-        _ => d,
-    }
+    pieces(poly, closed)
+        .map(|(p, q)| camkit::geom::dist::segment_segment_min(a, b, &p, &q))
+        .fold(f64::INFINITY, f64::min)
 }
 
 /// Distance from `q` to the polyline `poly` (closed if `closed`).
 fn poly_distance(q: &P2, poly: &[P2], closed: bool) -> f64 {
-    let mut d = camkit::geom::dist::point_polyline(q, poly);
-    if closed && poly.len() > 2 {
-        d = d.min(camkit::geom::dist::point_segment(q, &poly[poly.len() - 1], &poly[0]));
-    }
-    d
+    pieces(poly, closed).map(|(a, b)| camkit::geom::dist::point_segment(q, &a, &b)).fold(f64::INFINITY, f64::min)
+}
+
+/// Nearest distance (mm) from the window at which a point counts as R from it: R less its
+/// round-off.
+fn clear_at(r: f64) -> f64 {
+    r - 1e-9 * r.max(1.0)
 }
 
 /// Offsets a 3D contour (points with a tool axis each).
@@ -223,7 +226,7 @@ pub fn offset(pts: &[P3], axes: &[V3], closed: bool, opts: &Options) -> Result<O
             }
             // Clear: the corner points, and the moves from the offsets of the two pieces' middles
             // to them (the neighbours' moves meet these there), keep R from the window.
-            let lim = r - 1e-9 * r.max(1.0);
+            let lim = clear_at(r);
             let moves = [
                 (mid_offset(&poly, whole, at, false, s, r), points.first()),
                 (mid_offset(&poly, whole, at, true, s, r), points.last()),
@@ -313,15 +316,13 @@ fn owned_stretch(loops: &[Contour], poly: &[P2], whole: bool, at: usize, s: f64,
     let (prev, next) = (neighbour(m, whole, at, false), neighbour(m, whole, at, true));
     let half = |k: Option<usize>| k.map_or(0.0, |k| 0.5 * (poly[k] - v).norm());
     let reach = half(prev).max(half(next)) + r + chord_tol;
-    let pieces: Vec<(P2, P2)> =
-        (0..m - 1).map(|k| (poly[k], poly[k + 1])).chain((whole && m > 2).then(|| (poly[m - 1], poly[0]))).collect();
     // Where along the row's two half pieces the nearest window point of `q` lies: −1/2 … 0 on
     // the piece before, 0 … 1/2 on the piece after; None if elsewhere.
     let key = |q: &P2| -> Option<f64> {
         if (q - v).norm() > reach {
             return None;
         }
-        let d = pieces.iter().map(|(a, b)| camkit::geom::dist::point_segment(q, a, b)).fold(f64::INFINITY, f64::min);
+        let d = poly_distance(q, poly, whole);
         let along = |k: usize, fwd: bool| {
             let w = poly[k] - v;
             let t = ((q - v).dot(&w) / w.norm_squared()).clamp(0.0, 1.0);
@@ -379,7 +380,7 @@ fn owned_stretch(loops: &[Contour], poly: &[P2], whole: bool, at: usize, s: f64,
     }
     owned.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.total_cmp(&b.1)));
     let mut out: Vec<P2> = Vec::with_capacity(owned.len() + 2);
-    let valid = |q: &P2| poly_distance(q, poly, whole) >= r - 1e-9 * r.max(1.0);
+    let valid = |q: &P2| poly_distance(q, poly, whole) >= clear_at(r);
     let ends = [mid_offset(poly, whole, at, false, s, r), mid_offset(poly, whole, at, true, s, r)];
     for q in
         ends[0].iter().filter(|q| valid(q)).chain(owned.iter().map(|o| &o.2)).chain(ends[1].iter().filter(|q| valid(q)))
