@@ -164,6 +164,12 @@ pub const OPENING_LADDER: [f64; 5] = [1.1, 1.25, 1.5, 2.0, 3.0];
 /// line meets the previous pass's band tangentially).
 pub const ENGAGEMENT_ROUNDOFF_DEG: f64 = 1e-5;
 
+/// The default step over for a tool of radius `r` and a threshold of `threshold` degrees:
+/// R(1 − cos threshold), the straight side cut at the threshold ([`side_cut_deg`]'s inverse).
+pub fn default_step(r: f64, threshold: f64) -> f64 {
+    r * (1.0 - threshold.to_radians().cos())
+}
+
 /// Engagement of a straight side cut at radial depth `step` with a tool of radius `r`
 /// (degrees): acos(1 − step/R), 180° from a step of 2R on. Passes that follow one another at
 /// this step cannot hold a lower threshold on straight walls.
@@ -907,7 +913,7 @@ mod tests {
     fn side_cut_is_the_closed_form_and_the_default_step_meets_the_threshold() {
         // The step over R(1 − cos θ) side-cuts at θ; 0.6 R at acos(0.4) = 66.42°; 2R and more: a slot.
         for theta in [30.0f64, 40.0] {
-            assert!((side_cut_deg(5.0, 5.0 * (1.0 - theta.to_radians().cos())) - theta).abs() < 1e-9);
+            assert!((side_cut_deg(5.0, default_step(5.0, theta)) - theta).abs() < 1e-9);
         }
         assert!((side_cut_deg(2.0, 1.2) - 0.4f64.acos().to_degrees()).abs() < 1e-12);
         assert_eq!(side_cut_deg(2.0, 4.0), 180.0);

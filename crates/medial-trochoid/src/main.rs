@@ -172,7 +172,7 @@ fn run(args: Args) -> Result<()> {
     if threshold >= 180.0 {
         return Err(Error::input("--threshold must be under 180 degrees"));
     }
-    let step = positive(args.step.unwrap_or(r * (1.0 - threshold.to_radians().cos())), "--step")?;
+    let step = positive(args.step.unwrap_or(medial_trochoid::default_step(r, threshold)), "--step")?;
     let rt = positive(args.trochoid_radius.unwrap_or(0.5 * r), "--trochoid-radius")?;
     if let Some(p) = args.pitch {
         positive(p, "--pitch")?;
@@ -279,7 +279,7 @@ fn run(args: Args) -> Result<()> {
         let hint = if side_cut > threshold + medial_trochoid::ENGAGEMENT_ROUNDOFF_DEG {
             format!(
                 "; --step {step} mm side-cuts straight walls at {side_cut:.3}°, at most R(1 − cos threshold) = {:.4} mm holds the threshold",
-                r * (1.0 - threshold.to_radians().cos())
+                medial_trochoid::default_step(r, threshold)
             )
         } else {
             String::new()
