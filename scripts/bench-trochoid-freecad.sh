@@ -14,22 +14,22 @@ TARGET=${CARGO_TARGET_DIR:-target}
 cargo build --release -q -p medial-trochoid --bins
 B="$TARGET/release/medial-trochoid"
 SRC=data/medial-trochoid/box-die.csv
-COMMON=(--radius 5 --sample 1 --trochoid-radius 2.5 --derate 0.5)
+COMMON=(--radius 5 --sample 1 --trochoid-radius 2.5)
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 uptime
 field() { python3 -c "import json,sys; r=json.load(open(sys.argv[1])); print(' '.join(f'{k}={r[k]:.6g}' if isinstance(r[k], float) else f'{k}={r[k]}' for k in sys.argv[2:]))" "$@"; }
 "$B" "$SRC" "${COMMON[@]}" --report "$tmp/ours.json" -o "$tmp/ours.csv"
-echo "ours (plan, both programs): $(field "$tmp/ours.json" largest_engagement_deg samples_over_threshold link_samples_over_threshold trochoid_length_mm contour_length_mm trochoidal_minutes trochoidal_underated_minutes trochoidal_constant_feed_minutes offset_only_largest_engagement_deg offset_only_samples_over_threshold offset_only_length_mm offset_only_minutes offset_only_underated_minutes offset_only_variable_feed_minutes no_gouge seconds)"
+echo "ours (plan, both programs): $(field "$tmp/ours.json" largest_engagement_deg samples_over_threshold link_samples_over_threshold trochoid_length_mm contour_length_mm trochoidal_minutes trochoidal_chip_only_minutes trochoidal_constant_feed_minutes offset_only_largest_engagement_deg offset_only_samples_over_threshold offset_only_length_mm offset_only_minutes offset_only_chip_only_minutes offset_only_variable_feed_minutes no_gouge seconds)"
 "$B" "$SRC" "${COMMON[@]}" --analyse "$tmp/ours.csv" --report "$tmp/ours-a.json" -o "$tmp/ours-a.csv"
-echo "ours trochoids first, analysed: $(field "$tmp/ours-a.json" largest_engagement_deg samples_over_threshold link_samples_over_threshold length_mm minutes underated_minutes constant_feed_minutes constant_feed_underated_minutes smallest_wall_clearance_mm seconds)"
+echo "ours trochoids first, analysed: $(field "$tmp/ours-a.json" largest_engagement_deg samples_over_threshold link_samples_over_threshold length_mm minutes chip_only_minutes constant_feed_minutes constant_feed_chip_only_minutes smallest_wall_clearance_mm seconds)"
 "$B" "$SRC" "${COMMON[@]}" --program offset --report "$tmp/off.json" -o "$tmp/off.csv"
 "$B" "$SRC" "${COMMON[@]}" --analyse "$tmp/off.csv" --report "$tmp/off-a.json" -o "$tmp/off-a.csv"
-echo "ours offset only, analysed: $(field "$tmp/off-a.json" largest_engagement_deg samples_over_threshold length_mm minutes underated_minutes constant_feed_minutes constant_feed_underated_minutes smallest_wall_clearance_mm)"
+echo "ours offset only, analysed: $(field "$tmp/off-a.json" largest_engagement_deg samples_over_threshold length_mm minutes chip_only_minutes constant_feed_minutes constant_feed_chip_only_minutes smallest_wall_clearance_mm)"
 for step in 11.82 4; do
   python3 scripts/freecad-adaptive.py "$SRC" "$tmp/fc.csv" --diameter 10 --stepover "$step" --stock 0 0 100 100 --top 60
   "$B" "$SRC" "${COMMON[@]}" --analyse "$tmp/fc.csv" --report "$tmp/fc.json" -o "$tmp/fc-a.csv"
-  echo "freecad adaptive $step %, analysed: $(field "$tmp/fc.json" largest_engagement_deg samples_over_threshold length_mm entry_length_mm minutes underated_minutes constant_feed_minutes constant_feed_underated_minutes smallest_wall_clearance_mm seconds)"
+  echo "freecad adaptive $step %, analysed: $(field "$tmp/fc.json" largest_engagement_deg samples_over_threshold length_mm entry_length_mm minutes chip_only_minutes constant_feed_minutes constant_feed_chip_only_minutes smallest_wall_clearance_mm seconds)"
   python3 - "$tmp/fc-a.csv" <<'PY'
 import csv, sys
 e = sorted(float(r["engagement"]) for r in csv.DictReader(open(sys.argv[1])) if r["engagement"] and r["tag"] != "entry")

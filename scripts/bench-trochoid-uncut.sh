@@ -17,17 +17,16 @@ for case in "polygon12.csv --radius 5" "box-die.csv --radius 6" "box-die.csv --r
     /usr/bin/time -f %e -a -o "$T/u.t" "$BIN" "$D/$file" "$@" --report "$T/u.json" -o "$T/u.csv" 2>/dev/null
     /usr/bin/time -f %e -a -o "$T/n.t" "$BIN" "$D/$file" "$@" --no-leave-uncut --report "$T/n.json" -o "$T/n.csv" 2>/dev/null || true
   done
-  "$BIN" "$D/$file" "$@" --derate 0.5 --report "$T/d.json" -o "$T/d.csv" 2>/dev/null
   python3 - "$file $*" "$T" <<'PY'
 import json, sys
 case, t = sys.argv[1], sys.argv[2]
-u, n, d = (json.load(open(f"{t}/{k}.json")) for k in "und")
+u, n = (json.load(open(f"{t}/{k}.json")) for k in "un")
 best = lambda k: min(float(x) for x in open(f"{t}/{k}.t").read().split() if x[0].isdigit())
 thick = max(s["thickness_mm"] for s in u["uncut"])
 print(f"| `{case}` | {u['uncut_radius_mm']:.2f} | {len(u['uncut'])} | {u['uncut_area_mm2']:.3f} | {thick:.3f} "
       f"| {n['largest_engagement_deg']:.1f}° ({n['samples_over_threshold']}) | {u['largest_engagement_deg']:.4f}° "
       f"| {u['smallest_wall_clearance_mm']:.6f} | {u['offset_only_minutes']:.3f} / {u['trochoidal_minutes']:.3f} = {u['time_ratio']:.2f} "
-      f"| {d['time_ratio']:.2f} | {best('n'):.2f} / {best('u'):.2f} s |")
+      f"| {u['time_ratio_chip_only']:.2f} | {best('n'):.2f} / {best('u'):.2f} s |")
 PY
   rm -f "$T"/*.t
 done

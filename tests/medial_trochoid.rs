@@ -5,6 +5,13 @@ use e2e::{Work, data};
 
 const BIN: &str = "medial-trochoid";
 
+/// Mean cutting force per mm of feed per tooth of a straight side cut engaging `deg` degrees, in
+/// closed form: ½·|(φ − ½ sin 2φ, sin²φ)| (the feed model's units).
+fn side_force(deg: f64) -> f64 {
+    let phi = deg.to_radians();
+    0.5 * f64::hypot(phi - 0.5 * (2.0 * phi).sin(), phi.sin().powi(2))
+}
+
 fn report(w: &Work, name: &str) -> serde_json::Value {
     serde_json::from_str(&w.read(name)).expect("report is JSON")
 }
@@ -35,6 +42,37 @@ fn rows(csv: &str) -> Vec<(String, Option<f64>, f64, f64)> {
             (v[t].to_string(), v[e].parse().ok(), v[x].parse().unwrap(), v[y].parse().unwrap())
         })
         .collect()
+}
+
+/// Machining minutes of a written program, from its rows alone: each feed row's move from the
+/// row before (a chord, or the arc about `xc, yc` in its sense; in xy, as the model times it)
+/// at the row's feed.
+fn minutes_of(csv: &str) -> f64 {
+    let mut lines = csv.lines();
+    let header: Vec<&str> = lines.next().expect("header").split(',').collect();
+    let col = |n: &str| header.iter().position(|h| *h == n).unwrap_or_else(|| panic!("column {n}"));
+    let (m, x, y, xc, yc, f) = (col("move"), col("x"), col("y"), col("xc"), col("yc"), col("f"));
+    let num = |v: &[&str], k: usize| v[k].parse::<f64>().unwrap();
+    let (mut at, mut total) = ((0.0, 0.0), 0.0);
+    for l in lines {
+        let v: Vec<&str> = l.split(',').collect();
+        let to = (num(&v, x), num(&v, y));
+        let len = match v[m] {
+            "rapid" => 0.0,
+            "line" => f64::hypot(to.0 - at.0, to.1 - at.1),
+            sense => {
+                let c = (num(&v, xc), num(&v, yc));
+                let (a0, a1) = ((at.1 - c.1).atan2(at.0 - c.0), (to.1 - c.1).atan2(to.0 - c.0));
+                let sweep = if sense == "ccw" { a1 - a0 } else { a0 - a1 };
+                sweep.rem_euclid(std::f64::consts::TAU) * f64::hypot(to.0 - c.0, to.1 - c.1)
+            }
+        };
+        if v[m] != "rapid" {
+            total += len / num(&v, f);
+        }
+        at = to;
+    }
+    total
 }
 
 #[test]
@@ -147,7 +185,7 @@ fn wall_pass_corners_are_rounded_and_their_rest_named() {
     assert_eq!(s["corner_rests"], 0);
     // A given radius: four rests at the pocket's corners, r = R + ρ, thickness r(√2 − 1) and
     // area r²(1 − π/4) for the 90° corners.
-    let args = [sq, "--radius", "5", "--corner-radius", "2", "--derate", "0.5", "--report", "r.json", "-o", "t.csv"];
+    let args = [sq, "--radius", "5", "--corner-radius", "2", "--report", "r.json", "-o", "t.csv"];
     w.run(BIN, &args, b"").ok();
     let r = report(&w, "r.json");
     assert_eq!(r["corner_rests"], 4);
@@ -170,13 +208,22 @@ fn wall_pass_corners_are_rounded_and_their_rest_named() {
     }
     // The rounded program leaves the walls alone.
     assert_eq!(r["no_gouge"], true);
-    // Derating: every kind of move of the offset-only program has a worst engagement over the
-    // threshold, so at one feed per kind it takes exactly twice as long at a factor of 0.5.
+    // The force limit: the offset-only program's worst sample is its first pass, a slot
+    // (180°), so at one feed it runs at the slot feed: 1/6.8 of the 40° side cut's under the
+    // force limit, 1/1.56 (sin 40°) under the chip limit alone.
     let f = |k: &str| r[k].as_f64().unwrap_or_else(|| panic!("{k} in {r}"));
-    assert!((f("offset_only_minutes") - 2.0 * f("offset_only_underated_minutes")).abs() < 1e-9);
-    assert!(f("trochoidal_minutes") > f("trochoidal_underated_minutes"));
-    assert!(f("time_ratio") < f("time_ratio_underated"));
-    w.run(BIN, &[sq, "--radius", "5", "--derate", "1.5"], b"").fails(2, "--derate");
+    // (The innermost pass is a thin loop, a slot to within 1e-5 of its force.)
+    let slowdown = std::f64::consts::FRAC_PI_2 / side_force(40.0) * 40f64.to_radians().sin();
+    let ratio = f("offset_only_minutes") / f("offset_only_chip_only_minutes");
+    assert!((ratio - slowdown).abs() < 1e-5 * slowdown, "{ratio} vs {slowdown}");
+    assert!(f("trochoidal_minutes") >= f("trochoidal_chip_only_minutes"));
+    assert!(f("time_ratio") < f("time_ratio_chip_only"));
+    assert_eq!(r["force_limit_at_deg"], 40.0);
+    w.run(BIN, &[&args[..], &["--no-force-limit"]].concat(), b"").ok();
+    let n = report(&w, "r.json");
+    assert_eq!(n["force_limit_at_deg"], serde_json::Value::Null);
+    assert_eq!(n["offset_only_minutes"], r["offset_only_chip_only_minutes"]);
+    w.run(BIN, &[sq, "--radius", "5", "--force-at", "190"], b"").fails(2, "--force-at");
     w.run(BIN, &[sq, "--radius", "5", "--corner-radius", "-1"], b"").fails(2, "--corner-radius");
 }
 
@@ -202,9 +249,12 @@ fn a_given_toolpath_is_analysed_against_closed_forms() {
     assert_eq!(s["chains"], 1);
     assert_eq!(s["no_gouge"], true);
     assert!((f(&s, "smallest_wall_clearance_mm") - 10.0).abs() < 1e-9);
-    // Feed model: 180° is the slot feed, chip 0.03 mm × 6 teeth × 4 800 min⁻¹ = 864 mm/min,
-    // for the ramp and the slot alike.
-    assert!((f(&s, "minutes") - 40.0 / 864.0).abs() < 1e-9, "{s}");
+    // Feed model: 180° is the slot feed, for the ramp and the slot alike: chip 0.03 mm × 6 teeth
+    // × 4 800 min⁻¹ = 864 mm/min by the chip limit alone, and under the force limit the feed
+    // whose mean force (π/2 per mm of fz) is the 40° side cut's at 0.03 / sin 40° per tooth.
+    assert!((f(&s, "chip_only_minutes") - 40.0 / 864.0).abs() < 1e-9, "{s}");
+    let slot_feed = 864.0 / 40f64.to_radians().sin() * side_force(40.0) / std::f64::consts::FRAC_PI_2;
+    assert!((f(&s, "minutes") - 40.0 / slot_feed).abs() < 1e-9, "{s}");
     // A wall pass along y = 5, then a side cut of radial depth a: acos(1 − a/R) along its middle.
     for a in [0.5f64, 1.17, 2.0, 4.0] {
         let y = 5.0 + a;
@@ -273,6 +323,14 @@ fn box_die_whole_program_holds_the_threshold_links_included() {
     let out = rows(&w.read("t.csv"));
     let worst = out.iter().filter(|(t, ..)| t != "entry").filter_map(|r| r.1).fold(0.0, f64::max);
     assert!(worst <= 40.0005, "{worst}");
+    // The time estimate is the written feeds: the rows' own lengths and feeds give it again.
+    let f = |k: &str| r[k].as_f64().unwrap_or_else(|| panic!("{k} in {r}"));
+    let again = minutes_of(&w.read("t.csv"));
+    assert!((again - f("trochoidal_minutes")).abs() < 1e-9 * again, "{again} vs {r}");
+    // Paper 001's result, in its order: with feeds that keep the cutting force at most the 40°
+    // side cut's, the trochoids-first program takes less time than the offset passes at the
+    // feed their worst engagement (the slot) allows; by the chip limit alone it does not.
+    assert!(f("time_ratio") < 0.8 && f("time_ratio_chip_only") > 1.0, "{r}");
     // The same cavity drawn in DXF (12 LINEs chained, the boss a CIRCLE) gives the same program.
     let dxf = data("medial-trochoid/box-die.dxf");
     let args = [dxf.to_str().unwrap(), "--radius", "5", "--sample", "1", "--trochoid-radius", "2.5", "-o", "d.csv"];

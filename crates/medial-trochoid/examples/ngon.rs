@@ -39,7 +39,7 @@ fn main() {
         corner_radius: None,
         sample: 0.5,
         medial: MedialOptions::default(),
-        feed: FeedModel { spindle: 4800.0, teeth: 6.0, chip: 0.03, fz_max: 0.1, derate_above: 40.0, derate: 1.0 },
+        feed: FeedModel { spindle: 4800.0, teeth: 6.0, chip: 0.03, fz_max: 0.1, force_at: Some(40.0) },
     };
     let t0 = Instant::now();
     let p = plan(&regions, &s).expect("a plan");

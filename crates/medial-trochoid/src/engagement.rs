@@ -5,6 +5,7 @@
 //! annular sector along an arc). No polygon approximation: the angle is exact to round-off.
 
 use crate::angles::{AngleSet, merge};
+use crate::feed::Load;
 use camkit::contour::Seg;
 use camkit::geom::{P2, V2, arc::angle_of, cross2};
 use rayon::prelude::*;
@@ -228,6 +229,19 @@ impl Cut {
         self.on_piece(i, t, |p, own| gaps(&self.removed(p, i, own)))
     }
 
+    /// Engagement (degrees) at fraction `t` of piece `i` and the [`Load`] of its material arcs
+    /// for travel along the piece there (none on a piece too short to have a direction).
+    pub fn contact(&self, i: usize, t: f64) -> (f64, Load) {
+        self.on_piece(i, t, |p, own| {
+            let removed = self.removed(p, i, own);
+            let deg = (TAU - removed.iter().map(|(a, b)| b - a).sum::<f64>()).max(0.0).to_degrees();
+            let travel = self.pieces[i].tangent_at(t);
+            let load =
+                if travel.norm() > 0.5 { Load::of_arcs(&gaps(&removed), angle_of(&travel)) } else { Load::default() };
+            (deg, load)
+        })
+    }
+
     /// `f` of the tool centre at fraction `t` of piece `i` and what that piece has cut so far.
     fn on_piece<R>(&self, i: usize, t: f64, f: impl FnOnce(&P2, &[Seg]) -> R) -> R {
         let p = self.pieces[i].point_at(t);
@@ -266,15 +280,15 @@ impl Cut {
     /// Engagement (degrees) at each sample, computed in parallel (the result does not depend on
     /// the thread count: each sample is independent).
     pub fn profile(&self, samples: &[(usize, f64)]) -> Vec<f64> {
-        self.profile_from(samples, &[])
+        samples.par_iter().map(|&(i, t)| self.engagement(i, t).to_degrees()).collect()
     }
 
-    /// [`Cut::profile`] with the first `known.len()` engagements given (those of samples whose
-    /// pieces and every piece before are the same as when they were computed: the engagement
-    /// at a sample depends on nothing cut after it).
-    pub fn profile_from(&self, samples: &[(usize, f64)], known: &[f64]) -> Vec<f64> {
+    /// [`Cut::contact`] at each sample, in parallel, with the first `known.len()` given (those
+    /// of samples whose pieces and every piece before are the same as when they were computed:
+    /// what the tool meets at a sample depends on nothing cut after it).
+    pub fn contacts_from(&self, samples: &[(usize, f64)], known: &[(f64, Load)]) -> Vec<(f64, Load)> {
         let mut out = known.to_vec();
-        out.par_extend(samples[known.len()..].par_iter().map(|&(i, t)| self.engagement(i, t).to_degrees()));
+        out.par_extend(samples[known.len()..].par_iter().map(|&(i, t)| self.contact(i, t)));
         out
     }
 }
@@ -408,6 +422,13 @@ mod tests {
                 // Standing and after-the-cut forms too.
                 let standing = cut.engagement_at(&p, i).to_degrees();
                 prop_assert!((standing - brute(r, &p, &pieces[..i]).to_degrees()).abs() <= 1e-9);
+                // The contact is the same engagement with the load of those arcs.
+                let (deg, load) = cut.contact(i, t);
+                prop_assert!((deg - e).abs() <= 1e-12);
+                let travel = pieces[i].tangent_at(t);
+                if travel.norm() > 0.5 {
+                    prop_assert_eq!(load, Load::of_arcs(&cut.material(i, t), angle_of(&travel)));
+                }
             }
             let extra = &pieces[pieces.len() / 2..];
             let head = Cut::new(r, pieces[..pieces.len() / 2].to_vec());
@@ -448,6 +469,10 @@ mod tests {
                 assert_eq!(arcs.len(), 1, "ae {ae}: {arcs:?}");
                 assert!((arcs[0].0 - (1.0 - ae / r).asin()).abs() < 1e-9, "ae {ae}: {arcs:?}");
                 assert!((arcs[0].1 - FRAC_PI_2).abs() < 1e-9, "ae {ae}: {arcs:?}");
+                // Its load is the closed form's side cut of that angle.
+                let (_, load) = cut.contact(1, 0.5);
+                let side = Load::side_cut(exact.to_degrees());
+                assert!((load.force - side.force).abs() < 1e-9 && (load.chip - side.chip).abs() < 1e-9, "ae {ae}");
             }
         }
     }

@@ -28,7 +28,7 @@ use camkit::contour::pocket::{Direction, Pass, Passes, PocketOptions, pocket};
 use camkit::contour::region::Region;
 use camkit::geom::P2;
 use engagement::Cut;
-use feed::FeedModel;
+use feed::{FeedModel, Load};
 use medial::{Medial, MedialOptions, medial_axis};
 use program::{Program, Tag, clearance, point_clearance};
 use rayon::prelude::*;
@@ -70,6 +70,8 @@ pub struct Analysed {
     pub samples: Vec<(usize, f64)>,
     /// Engagement at each sample (degrees).
     pub engagement: Vec<f64>,
+    /// What the teeth meet at each sample, for the feed model.
+    pub loads: Vec<Load>,
     /// Feed (mm/min) at each sample (of the move up to it).
     pub feeds: Vec<f64>,
     /// Largest engagement over cutting moves (trochoids and passes, entries excluded).
@@ -84,12 +86,12 @@ pub struct Analysed {
     pub max_entry: f64,
     /// Machining time of the layer (min) with the feed following the engagement sample by sample.
     pub minutes: f64,
-    /// Machining time of the layer (min) with each kind of move at the feed its worst engagement allows.
+    /// Machining time of the layer (min) with each kind of move at the feed its slowest sample allows.
     pub minutes_constant: f64,
-    /// [`Analysed::minutes`] under the feed model without its derating.
-    pub minutes_underated: f64,
-    /// [`Analysed::minutes_constant`] under the feed model without its derating.
-    pub minutes_constant_underated: f64,
+    /// [`Analysed::minutes`] under the feed model's chip-thickness limit alone.
+    pub minutes_chip_only: f64,
+    /// [`Analysed::minutes_constant`] under the feed model's chip-thickness limit alone.
+    pub minutes_constant_chip_only: f64,
     /// Smallest distance from the tool centre to the walls (mm).
     pub wall_clearance: f64,
 }
@@ -235,8 +237,7 @@ impl std::fmt::Display for PlanError {
     }
 }
 
-/// Simulates `program` for a tool of radius `r` and times it: feed moves of each kind run at
-/// the feed their worst engagement allows (entries at the slot feed).
+/// Simulates `program` for a tool of radius `r` and times it (see [`Analysed`]'s minutes).
 pub fn analyse(program: Program, s: &Settings, regions: &[Region]) -> Analysed {
     analyse_after(program, s, regions, &Analysed::default(), 0)
 }
@@ -257,7 +258,9 @@ pub fn analyse_after(
         previous.program.moves[..unchanged.min(previous.program.moves.len())]
             == program.moves[..unchanged.min(program.moves.len())]
     );
-    let engagement = cut.profile_from(&samples, &previous.engagement[..same]);
+    let known: Vec<(f64, Load)> =
+        previous.engagement.iter().copied().zip(previous.loads.iter().copied()).take(same).collect();
+    let (engagement, loads): (Vec<f64>, Vec<Load>) = cut.contacts_from(&samples, &known).into_iter().unzip();
     let mut worst: HashMap<Tag, f64> = HashMap::new();
     for (&(i, _), &e) in samples.iter().zip(&engagement) {
         let w = worst.entry(program.moves[i].tag).or_insert(0.0);
@@ -271,9 +274,8 @@ pub fn analyse_after(
         .zip(&engagement)
         .filter(|((i, _), e)| program.moves[*i].tag == Tag::Link && **e > s.threshold + ENGAGEMENT_ROUNDOFF_DEG)
         .count();
-    let (feeds, minutes, minutes_constant) = times(&program, &samples, &engagement, &get, &s.feed);
-    let (_, minutes_underated, minutes_constant_underated) =
-        times(&program, &samples, &engagement, &get, &s.feed.underated());
+    let (feeds, minutes, minutes_constant) = times(&program, &samples, &loads, &s.feed);
+    let (_, minutes_chip_only, minutes_constant_chip_only) = times(&program, &samples, &loads, &s.feed.chip_only());
     let wall_clearance = program
         .moves
         .iter()
@@ -283,6 +285,7 @@ pub fn analyse_after(
         program,
         samples,
         engagement,
+        loads,
         feeds,
         max_cutting,
         max_link: get(Tag::Link),
@@ -291,38 +294,41 @@ pub fn analyse_after(
         max_entry: get(Tag::Entry),
         minutes,
         minutes_constant,
-        minutes_underated,
-        minutes_constant_underated,
+        minutes_chip_only,
+        minutes_constant_chip_only,
         wall_clearance,
     }
 }
 
 /// Feeds per sample and the layer's minutes under `model` for two feed strategies: every sample
-/// at the feed its own engagement allows (the larger of the engagements at its two ends; air at
-/// the tool's largest feed per tooth), and each kind of move at one feed, the one its worst
-/// engagement (`worst`) allows. Entries ramp at the slot feed.
-fn times(
-    program: &Program,
-    samples: &[(usize, f64)],
-    engagement: &[f64],
-    worst: &dyn Fn(Tag) -> f64,
-    model: &FeedModel,
-) -> (Vec<f64>, f64, f64) {
+/// at the feed its own load allows (the slower of the loads at its two ends; air at the tool's
+/// largest feed per tooth), and each kind of move at one feed, the one its slowest sample
+/// allows. Entries ramp at the slot feed.
+fn times(program: &Program, samples: &[(usize, f64)], loads: &[Load], model: &FeedModel) -> (Vec<f64>, f64, f64) {
     let mut feeds = Vec::with_capacity(samples.len());
+    let mut slowest: HashMap<Tag, f64> = HashMap::new();
+    let mut before: Option<(usize, f64)> = None;
+    let slot = Load::slot();
+    for (&(i, _), load) in samples.iter().zip(loads) {
+        let tag = program.moves[i].tag;
+        let own = model.feed(if tag == Tag::Entry { &slot } else { load });
+        let w = slowest.entry(tag).or_insert(f64::INFINITY);
+        *w = w.min(own);
+        feeds.push(match before {
+            Some((j, f0)) if j == i => own.min(f0),
+            _ => own,
+        });
+        before = Some((i, own));
+    }
     let (mut minutes, mut minutes_constant) = (0.0, 0.0);
-    let mut before = (usize::MAX, 0.0, 0.0);
-    for (&(i, t), &e) in samples.iter().zip(engagement) {
+    let mut t0 = (usize::MAX, 0.0);
+    for (&(i, t), f) in samples.iter().zip(&feeds) {
         let m = &program.moves[i];
-        let (t0, e0) = if before.0 == i { (before.1, before.2) } else { (0.0, e) };
-        let (f, fc) = match m.tag {
-            Tag::Entry => (model.feed(180.0), model.feed(180.0)),
-            t => (model.feed(e.max(e0)), model.feed(worst(t))),
-        };
-        let len = m.seg.length() * (t - t0);
+        let from = if t0.0 == i { t0.1 } else { 0.0 };
+        let len = m.seg.length() * (t - from);
         minutes += len / f;
-        minutes_constant += len / fc;
-        feeds.push(f);
-        before = (i, t, e);
+        minutes_constant += len / slowest[&m.tag];
+        t0 = (i, t);
     }
     (feeds, minutes, minutes_constant)
 }

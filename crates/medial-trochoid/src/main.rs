@@ -105,20 +105,24 @@ struct Args {
     /// Number of teeth.
     #[arg(long, default_value_t = 6.0, value_name = "N")]
     teeth: f64,
-    /// Largest chip thickness (mm): the feed per tooth is chip / sin(engagement), for engagement ≤ 90°.
+    /// Largest chip thickness (mm): a tooth at angle β from the travel cuts fz·cos β, so the feed
+    /// per tooth is at most chip / (the largest cos β over the material arcs ahead): chip / sin φ
+    /// for a side cut of engagement φ ≤ 90°.
     #[arg(long, default_value_t = 0.03, value_name = "MM")]
     chip: f64,
     /// Largest feed per tooth of the tool (mm).
     #[arg(long, default_value_t = 0.1, value_name = "MM")]
     fz_max: f64,
-    /// Hard-steel derating of the feed model: above this engagement (degrees; default the
-    /// threshold) the feed is multiplied by --derate.
+    /// The force limit of the feed model (paper 001: feeds that keep the cutting force nearly
+    /// constant): the engagement (degrees; default the threshold) of the straight side cut whose
+    /// mean cutting force at its chip-limited feed is the most the tool takes. Heavier cuts run
+    /// proportionally slower (a slot at 1/6.8 of the 40° side cut's feed). The report gives times
+    /// and ratios with it and with the chip limit alone.
     #[arg(long, value_name = "DEG")]
-    derate_above: Option<f64>,
-    /// Factor on the feed above --derate-above (1: no derating). The report gives times and
-    /// ratios with and without it.
-    #[arg(long, default_value_t = 1.0, value_name = "K")]
-    derate: f64,
+    force_at: Option<f64>,
+    /// Time with the chip-thickness limit alone (no force limit).
+    #[arg(long, conflicts_with = "force_at")]
+    no_force_limit: bool,
     /// Decimals of written positions (exact by default).
     #[arg(long, value_name = "N")]
     decimals: Option<u32>,
@@ -210,10 +214,12 @@ fn run(args: Args) -> Result<()> {
             teeth: positive(args.teeth, "--teeth")?,
             chip: positive(args.chip, "--chip")?,
             fz_max: positive(args.fz_max, "--fz-max")?,
-            derate_above: positive(args.derate_above.unwrap_or(threshold), "--derate-above")?,
-            derate: match positive(args.derate, "--derate")? {
-                k if k > 1.0 => return Err(Error::input(format!("--derate must be at most 1, got {k}"))),
-                k => k,
+            force_at: match args.force_at.unwrap_or(threshold) {
+                _ if args.no_force_limit => None,
+                deg if deg > 0.0 && deg <= 180.0 => Some(deg),
+                deg => {
+                    return Err(Error::input(format!("--force-at must be over 0 and at most 180 degrees, got {deg}")));
+                }
             },
         },
     };
@@ -415,11 +421,10 @@ fn run(args: Args) -> Result<()> {
             .set("trochoidal_minutes", b.minutes * layers)
             .set("trochoidal_constant_feed_minutes", b.minutes_constant * layers)
             .set("time_ratio", b.minutes / a.minutes_constant)
-            .set("derate_above_deg", settings.feed.derate_above)
-            .set("derate", settings.feed.derate)
-            .set("offset_only_underated_minutes", a.minutes_constant_underated * layers)
-            .set("trochoidal_underated_minutes", b.minutes_underated * layers)
-            .set("time_ratio_underated", b.minutes_underated / a.minutes_constant_underated)
+            .set("force_limit_at_deg", settings.feed.force_at)
+            .set("offset_only_chip_only_minutes", a.minutes_constant_chip_only * layers)
+            .set("trochoidal_chip_only_minutes", b.minutes_chip_only * layers)
+            .set("time_ratio_chip_only", b.minutes_chip_only / a.minutes_constant_chip_only)
             .set("corner_rests", plan.rests.len())
             .set("corner_radii_mm", plan.rests.iter().map(|c| c.rho).collect::<Vec<_>>())
             .set("corner_rest_thickness_mm", plan.rests.iter().map(|c| c.thickness()).collect::<Vec<_>>())
@@ -506,10 +511,9 @@ fn analyse_given(
             .set("no_gouge", a.wall_clearance >= s.radius + s.allowance - camkit::tol::OFFSET_TOL)
             .set("minutes", a.minutes)
             .set("constant_feed_minutes", a.minutes_constant)
-            .set("derate_above_deg", s.feed.derate_above)
-            .set("derate", s.feed.derate)
-            .set("underated_minutes", a.minutes_underated)
-            .set("constant_feed_underated_minutes", a.minutes_constant_underated)
+            .set("force_limit_at_deg", s.feed.force_at)
+            .set("chip_only_minutes", a.minutes_chip_only)
+            .set("constant_feed_chip_only_minutes", a.minutes_constant_chip_only)
             .set("output_rows", out_table.rows.len())
             .set("seconds", started.elapsed().as_secs_f64());
         rep.write(report)?;
