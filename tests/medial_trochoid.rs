@@ -375,6 +375,56 @@ fn many_sided_pocket_holds_the_threshold_without_gouge() {
 }
 
 #[test]
+fn round_pocket_steps_in_by_the_concave_closed_form_and_holds_the_threshold() {
+    // A circle of radius 15: every pass is an arc round the pocket, side-cut over the straight
+    // cut's engagement at the same step (44.4° at ρ = 12 with R3 at the 40° step). Each step is
+    // the largest whose concave closed form holds 40°, down to passes of radius R/8.
+    let w = Work::new();
+    let src = data("medial-trochoid/circle15.csv");
+    for r in [3.0f64, 5.0] {
+        let rs = r.to_string();
+        let args = [src.to_str().unwrap(), "--radius", &rs, "--report", "r.json", "-o", "t.csv"];
+        w.run(BIN, &args, b"").ok();
+        let rep = report(&w, "r.json");
+        assert_holds(&rep, &w.read("t.csv"), r);
+        let f = |k: &str| rep[k].as_f64().unwrap_or_else(|| panic!("{k} in {rep}"));
+        assert!(f("offset_only_largest_engagement_deg") > 90.0, "the innermost pass slots: {rep}");
+        // The centre's medial axis is one point drawn as many short edges: their runs, all at
+        // the centre, are one cluster of loops, not one per edge.
+        assert!(rep["trochoid_runs"].as_u64().unwrap() <= 4, "{rep}");
+        assert!(f("time_ratio") < 1.0, "{rep}");
+        // The passes' radii, from the rows of arcs about the centre.
+        let csv = w.read("t.csv");
+        let mut lines = csv.lines();
+        let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+        let col = |n: &str| header.iter().position(|h| *h == n).unwrap();
+        let (m, x, y, xc, yc, tag) = (col("move"), col("x"), col("y"), col("xc"), col("yc"), col("tag"));
+        let mut radii: Vec<f64> = lines
+            .map(|l| l.split(',').collect::<Vec<_>>())
+            .filter(|v| v[tag] == "contour" && (v[m] == "ccw" || v[m] == "cw"))
+            .filter(|v| v[xc].parse::<f64>().unwrap().abs() < 1e-9 && v[yc].parse::<f64>().unwrap().abs() < 1e-9)
+            .map(|v| v[x].parse::<f64>().unwrap().hypot(v[y].parse().unwrap()))
+            .collect();
+        radii.sort_by(|a, b| b.total_cmp(a));
+        radii.dedup_by(|a, b| (*a - *b).abs() < 1e-9);
+        assert!((radii[0] - (15.0 - r)).abs() < 1e-9, "the wall pass: {radii:?}");
+        let phi = |rho: f64, s: f64| (1.0 - s / r - s / rho + s * s / (2.0 * rho * r)).acos().to_degrees();
+        let stepped: Vec<f64> = radii
+            .windows(2)
+            .filter(|w| w[0] >= r / 8.0)
+            .map(|w| {
+                let e = phi(w[0], w[0] - w[1]);
+                assert!((e - 40.0).abs() < 1e-6, "ρ {} → {}: {e}°", w[0], w[1]);
+                w[0] - w[1]
+            })
+            .collect();
+        // Steps shrink towards the centre, all under the straight side cut's.
+        assert!(stepped.len() >= 10 && stepped.windows(2).all(|s| s[1] < s[0]), "{stepped:?}");
+        assert!(stepped[0] < r * (1.0 - 40f64.to_radians().cos()));
+    }
+}
+
+#[test]
 fn material_over_the_threshold_after_the_plan_is_cleared_by_a_repair() {
     // A 20-gon of radius 15 (R5): the offset-only wall pass starts at the vertex at 0° and
     // its own start clears ahead of the last vertices before it, so their spokes are not

@@ -271,6 +271,14 @@ pub fn concave_engagement(r: f64, rho: f64, s: f64) -> f64 {
     (1.0 - s / r - s / rho + s * s / (2.0 * rho * r)).clamp(-1.0, 1.0).acos()
 }
 
+/// The largest step `s` at which [`concave_engagement`] stays at most `phi` (radians): the smaller
+/// root of s²/(2ρR) − s(1/R + 1/ρ) + 1 − cos φ = 0 (always real), in the form without
+/// cancellation: the straight side cut's R(1 − cos φ) as ρ → ∞, falling to 0 with ρ.
+pub fn concave_step(r: f64, rho: f64, phi: f64) -> f64 {
+    let (a, b, c) = (0.5 / (rho * r), 1.0 / r + 1.0 / rho, 1.0 - phi.cos());
+    2.0 * c / (b + (b * b - 4.0 * a * c).sqrt())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -358,5 +366,14 @@ mod tests {
         }
         // The straight side cut is the limit.
         assert!((concave_engagement(5.0, 1e12, 1.0) - 0.8f64.acos()).abs() < 1e-9);
+        // The step is its inverse, the side cut's step in the limit, smaller the tighter the arc.
+        for rho in [0.1, 1.0, 2.5, 5.0, 20.0, 1e3] {
+            for deg in [10.0f64, 40.0, 60.0] {
+                let s = concave_step(5.0, rho, deg.to_radians());
+                assert!((concave_engagement(5.0, rho, s) - deg.to_radians()).abs() < 1e-9, "ρ {rho} {deg}°");
+                assert!(s < 5.0 * (1.0 - deg.to_radians().cos()));
+            }
+        }
+        assert!((concave_step(5.0, 1e12, 40f64.to_radians()) - 5.0 * (1.0 - 40f64.to_radians().cos())).abs() < 1e-9);
     }
 }

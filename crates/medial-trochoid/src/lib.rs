@@ -24,7 +24,7 @@ pub mod trochoid;
 pub mod uncut;
 
 use camkit::contour::OffsetOptions;
-use camkit::contour::pocket::{Direction, Pass, Passes, PocketOptions, pocket};
+use camkit::contour::pocket::{Direction, Pass, Passes, PocketOptions, pocket_stepped};
 use camkit::contour::region::Region;
 use camkit::geom::P2;
 use engagement::Cut;
@@ -170,6 +170,29 @@ pub const ENGAGEMENT_ROUNDOFF_DEG: f64 = 1e-5;
 /// R(1 − cos threshold), the straight side cut at the threshold ([`side_cut_deg`]'s inverse).
 pub fn default_step(r: f64, threshold: f64) -> f64 {
     r * (1.0 - threshold.to_radians().cos())
+}
+
+/// Arcs of a pass tighter than this many tool radii are left to the trochoids like corners: the
+/// step after a pass is limited only by its arcs of radius R or more, which keeps it at least
+/// half the straight side cut's ([`corner::concave_step`] at ρ = R, within 1 %).
+pub const STEP_ARCS_FROM: f64 = 0.125;
+
+/// The step after a pass whose loops (oriented as a region: material to the right of travel
+/// when cut) are `loops`: `s.step`, or less where the loops curve round the pocket. A pass
+/// along an arc of radius ρ centred on the pocket's side cuts outward from the concentric pass
+/// a step inside it at acos(1 − s/R − s/ρ + s²/(2ρR)), more than the straight side cut's, so
+/// the step is the largest that holds the threshold on the pass's tightest such arc of radius
+/// R × [`STEP_ARCS_FROM`] or more.
+pub fn step_after(loops: &[camkit::contour::Contour], s: &Settings) -> f64 {
+    let tightest = loops
+        .iter()
+        .flat_map(|c| c.segs())
+        .filter_map(|g| match g {
+            camkit::contour::Seg::Arc(a) if a.sweep > 0.0 && a.r >= STEP_ARCS_FROM * s.radius => Some(a.r),
+            _ => None,
+        })
+        .reduce(f64::min);
+    tightest.map_or(s.step, |rho| s.step.min(corner::concave_step(s.radius, rho, s.threshold.to_radians())))
 }
 
 /// Engagement of a straight side cut at radial depth `step` with a tool of radius `r`
@@ -393,8 +416,9 @@ fn plan_in(regions: &[Region], walls: &[Region], s: &Settings) -> Result<Plan, P
         direction: Direction::Climb,
         offset: OffsetOptions::default(),
     };
-    let pocket =
-        pocket(regions, &opts).map_err(|e| PlanError::Pocket(format!("offset {} mm: {}", e.distance, e.error)))?;
+    let rule = |loops: &[camkit::contour::Contour]| step_after(loops, s);
+    let pocket = pocket_stepped(regions, &opts, Some(&rule))
+        .map_err(|e| PlanError::Pocket(format!("offset {} mm: {}", e.distance, e.error)))?;
     if pocket.passes.is_empty() {
         return Err(PlanError::NoPasses);
     }
@@ -569,7 +593,44 @@ fn dangerous(
             }
         }
     }
-    Stretches { danger, runs, uncleared }
+    Stretches { danger, runs: uncovered(runs), uncleared }
+}
+
+/// How far (mm) a loop may reach past an earlier one and still count as inside it: round-off of
+/// points of the medial axis that are one point in exact arithmetic (the centre of a circle
+/// drawn with chords) and of their clearance.
+const COVER_TOL: f64 = 1e-3;
+
+/// `runs` without those whose every loop lies inside a loop of a run kept before it (the disk of
+/// radius r about p inside the one of radius r' about q: |p − q| + r ≤ r' + [`COVER_TOL`]):
+/// such a run's tool only sweeps again what the earlier one swept (e.g. the many short
+/// stretches of a circle's medial axis, all at its centre). The whole-program simulation
+/// still checks the result.
+fn uncovered(runs: Vec<Run>) -> Vec<Run> {
+    let cell = runs.iter().flat_map(|r| r.radii.iter().copied()).fold(0.0, f64::max) + COVER_TOL;
+    let key = |p: &P2| ((p.x / cell).floor() as i64, (p.y / cell).floor() as i64);
+    let mut kept_disks: HashMap<(i64, i64), Vec<(P2, f64)>> = HashMap::new();
+    let mut kept = Vec::new();
+    for run in runs {
+        let inside = |p: &P2, r: f64| {
+            let (kx, ky) = key(p);
+            (kx - 1..=kx + 1).any(|x| {
+                (ky - 1..=ky + 1).any(|y| {
+                    kept_disks
+                        .get(&(x, y))
+                        .is_some_and(|v| v.iter().any(|(q, rq)| (q - p).norm() + r <= rq + COVER_TOL))
+                })
+            })
+        };
+        if run.points.iter().zip(&run.radii).all(|(p, &r)| inside(p, r)) {
+            continue;
+        }
+        for (p, &r) in run.points.iter().zip(&run.radii) {
+            kept_disks.entry(key(p)).or_default().push((*p, r));
+        }
+        kept.push(run);
+    }
+    kept
 }
 
 /// A trochoids-first program and what making it decided.
@@ -924,5 +985,63 @@ mod tests {
         assert!((side_cut_deg(2.0, 1.2) - 0.4f64.acos().to_degrees()).abs() < 1e-12);
         assert_eq!(side_cut_deg(2.0, 4.0), 180.0);
         assert_eq!(side_cut_deg(2.0, 5.0), 180.0);
+    }
+
+    #[test]
+    fn the_step_after_a_pass_follows_its_tightest_arc_round_the_pocket() {
+        use camkit::contour::Contour;
+        let s = Settings {
+            radius: 4.0,
+            step: default_step(4.0, 40.0),
+            threshold: 40.0,
+            trochoid_radius: 2.0,
+            pitch: None,
+            allowance: 0.0,
+            corner_radius: None,
+            sample: 0.5,
+            medial: MedialOptions::default(),
+            feed: FeedModel { spindle: 4800.0, teeth: 6.0, chip: 0.03, fz_max: 0.1, force_at: Some(40.0) },
+        };
+        let phi = 40f64.to_radians();
+        let square =
+            Contour::polygon(&[P2::new(0.0, 0.0), P2::new(9.0, 0.0), P2::new(9.0, 9.0), P2::new(0.0, 9.0)], true);
+        // Straight sides: the given step.
+        assert_eq!(step_after(std::slice::from_ref(&square), &s), s.step);
+        // A pass round a circle of radius 10 (counter-clockwise: the pocket's side), and an island's
+        // loop (clockwise: it curves away from the material) of radius 3.
+        let round = Contour::circle(P2::new(50.0, 0.0), 10.0, 0.0, true);
+        let island = Contour::circle(P2::new(50.0, 0.0), 3.0, 0.0, false);
+        let step = step_after(&[square.clone(), round.clone(), island], &s);
+        assert!((step - corner::concave_step(4.0, 10.0, phi)).abs() < 1e-15);
+        assert!((corner::concave_engagement(4.0, 10.0, step) - phi).abs() < 1e-12);
+        // The tightest arc decides, down to R/8; tighter ones are left to the trochoids.
+        let tight = Contour::circle(P2::new(0.0, 50.0), 0.6, 0.0, true);
+        let step = step_after(&[round.clone(), tight], &s);
+        assert!((step - corner::concave_step(4.0, 0.6, phi)).abs() < 1e-15);
+        let tighter = Contour::circle(P2::new(0.0, 50.0), 0.49, 0.0, true);
+        assert_eq!(step_after(&[round.clone(), tighter], &s), corner::concave_step(4.0, 10.0, phi));
+        // A step given under the concave one stays.
+        let small = Settings { step: 0.2, ..s };
+        assert_eq!(step_after(&[round], &small), 0.2);
+    }
+
+    #[test]
+    fn runs_inside_earlier_loops_are_dropped() {
+        let run = |pts: &[(f64, f64)], r: f64| Run {
+            points: pts.iter().map(|&(x, y)| P2::new(x, y)).collect(),
+            radii: vec![r; pts.len()],
+            pitches: vec![0.1; pts.len()],
+        };
+        let along: Vec<(f64, f64)> = (0..=20).map(|k| (0.25 * f64::from(k), 0.0)).collect();
+        let first = run(&along, 2.0);
+        // The same stretch a micron off (a circle's centre drawn as many short edges).
+        let again = run(&[(0.0, 1e-4), (1e-4, 0.0)], 2.0 - 5e-4);
+        // Smaller loops inside the first's.
+        let inner = run(&[(1.0, 0.5), (4.0, -0.5)], 1.0);
+        // Reaching past them by more than the tolerance, or elsewhere.
+        let past = run(&[(1.0, 0.0), (6.0, 0.0)], 2.0);
+        let away = run(&[(20.0, 0.0)], 2.0);
+        let kept = uncovered(vec![first.clone(), again, inner, past.clone(), away.clone()]);
+        assert_eq!(kept, vec![first, past, away]);
     }
 }

@@ -46,7 +46,9 @@ struct Args {
     /// Tool radius R (mm).
     #[arg(long, value_name = "MM")]
     radius: f64,
-    /// Radial step over between passes (mm); default R(1 − cos threshold), the side cut at the threshold.
+    /// Radial step over between passes (mm); default R(1 − cos threshold), the side cut at the
+    /// threshold. After a pass with arcs round the pocket (radius ρ ≥ R/8) the step is at most
+    /// the one whose concave side cut acos(1 − s/R − s/ρ + s²/(2ρR)) holds the threshold.
     #[arg(long, value_name = "MM")]
     step: Option<f64>,
     /// Engagement threshold (degrees).

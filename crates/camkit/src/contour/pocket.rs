@@ -125,11 +125,34 @@ fn pieces_of(loops: Vec<Contour>, level: usize, distance: f64) -> Vec<Piece> {
     out
 }
 
-/// Machining-order passes of `regions`.
+/// Machining-order passes of `regions`, every step `opts.step`.
 pub fn pocket(regions: &[Region], opts: &PocketOptions) -> Result<Pocket, PocketError> {
+    pocket_stepped(regions, opts, None)
+}
+
+/// The step after a level, chosen from that level's loops (e.g. smaller where they curve).
+pub type StepRule<'a> = &'a (dyn Fn(&[Contour]) -> f64 + Sync);
+
+/// [`pocket`] with the step after each level given by `step_after` from the level's loops
+/// (`None`: `opts.step` everywhere). With a rule the levels are offset one after the other, each
+/// from the region at its own total distance; `opts.step` still bounds the clean-up passes'
+/// search.
+pub fn pocket_stepped(
+    regions: &[Region],
+    opts: &PocketOptions,
+    step_after: Option<StepRule>,
+) -> Result<Pocket, PocketError> {
     let mut result = Pocket::default();
     let mut cursor: Option<P2> = None;
     for (ri, region) in regions.iter().enumerate() {
+        let input = RegionPieces::new(region);
+        let at = |d: f64| {
+            offset_region_in(region, &input, d, &opts.offset).map_err(|error| PocketError {
+                region: ri,
+                distance: d,
+                error,
+            })
+        };
         let levels = match opts.passes {
             Passes::Count(n) => n,
             Passes::UntilEmpty => {
@@ -138,23 +161,38 @@ pub fn pocket(regions: &[Region], opts: &PocketOptions) -> Result<Pocket, Pocket
                 ((half - opts.radius) / opts.step).floor().max(0.0) as usize + 2
             }
         };
-        let mut distances: Vec<f64> = (0..levels).map(|k| opts.radius + k as f64 * opts.step).collect();
-        // The region's pieces serve every level; levels beyond the first one proved empty are
-        // not computed (the loop below stops at the first empty level anyway).
-        let input = RegionPieces::new(region);
-        if let Some(k) = input.first_empty_level(&distances, &opts.offset) {
-            distances.truncate(k + 1);
-        }
-        let offsets: Vec<Result<super::Offset, PocketError>> = distances
-            .par_iter()
-            .map(|&d| {
-                offset_region_in(region, &input, d, &opts.offset).map_err(|error| PocketError {
-                    region: ri,
-                    distance: d,
-                    error,
-                })
-            })
-            .collect();
+        let (distances, offsets): (Vec<f64>, Vec<Result<super::Offset, PocketError>>) = match step_after {
+            None => {
+                let mut distances: Vec<f64> = (0..levels).map(|k| opts.radius + k as f64 * opts.step).collect();
+                // The region's pieces serve every level; levels beyond the first one proved
+                // empty are not computed (the loop below stops at the first empty level anyway).
+                if let Some(k) = input.first_empty_level(&distances, &opts.offset) {
+                    distances.truncate(k + 1);
+                }
+                let offsets = distances.par_iter().map(|&d| at(d)).collect();
+                (distances, offsets)
+            }
+            Some(rule) => {
+                let (mut distances, mut offsets) = (Vec::new(), Vec::new());
+                let mut d = opts.radius;
+                loop {
+                    let o = at(d)?;
+                    let more = opts.passes == Passes::UntilEmpty || distances.len() + 1 < levels;
+                    let next = (more && !o.contours.is_empty()).then(|| {
+                        let step = rule(&o.contours);
+                        assert!(step.is_finite() && step > 0.0, "a step rule gives positive steps, not {step}");
+                        d + step
+                    });
+                    distances.push(d);
+                    offsets.push(Ok(o));
+                    match next {
+                        Some(n) => d = n,
+                        None => break,
+                    }
+                }
+                (distances, offsets)
+            }
+        };
         let mut pieces: Vec<Piece> = Vec::new();
         let mut previous: Vec<usize> = Vec::new();
         for (k, o) in offsets.into_iter().enumerate() {
@@ -399,6 +437,46 @@ mod tests {
                 prop_assert!(false, "R {radius} step {step}: {e:?}");
             }
         }
+    }
+
+    /// A step rule sees each level's loops and sets the next distance: here a tenth of the loop's
+    /// arc radius round a circle of radius 20, so every level's radius is 0.9 of the one before
+    /// it; `Count` still caps the levels, and without a rule the steps are constant.
+    #[test]
+    fn a_step_rule_sets_each_level_from_the_one_before() {
+        let (rs, _) = regions(&[Contour::circle(P2::new(0.0, 0.0), 20.0, 0.0, true)]).expect("a region");
+        let arc_radius = |loops: &[Contour]| match loops[0].seg(0) {
+            super::super::Seg::Arc(a) => a.r,
+            _ => panic!("a circle's offset is arcs"),
+        };
+        let rule = |loops: &[Contour]| 0.1 * arc_radius(loops);
+        let opts = PocketOptions {
+            radius: 1.0,
+            step: 3.0,
+            passes: Passes::UntilEmpty,
+            direction: Direction::Climb,
+            offset: OffsetOptions::default(),
+        };
+        let p = pocket_stepped(&rs, &opts, Some(&rule)).unwrap_or_else(|e| panic!("{e:?}"));
+        let mut levels: Vec<(usize, f64)> =
+            p.passes.iter().filter(|q| !q.clean_up).map(|q| (q.level, q.distance)).collect();
+        levels.sort_by_key(|l| l.0);
+        assert!(levels.len() > 20, "{levels:?}");
+        for (k, (level, d)) in levels.iter().enumerate() {
+            assert_eq!(*level, k);
+            assert!((20.0 - d - 19.0 * 0.9f64.powi(k as i32)).abs() < 1e-9, "level {k}: {d}");
+        }
+        let counted = pocket_stepped(&rs, &PocketOptions { passes: Passes::Count(4), ..opts }, Some(&rule))
+            .unwrap_or_else(|e| panic!("{e:?}"));
+        assert_eq!(counted.passes.len(), 4);
+        let plain = pocket(&rs, &opts).unwrap_or_else(|e| panic!("{e:?}"));
+        assert!(
+            plain
+                .passes
+                .iter()
+                .filter(|q| !q.clean_up)
+                .all(|q| (q.distance - 1.0 - 3.0 * q.level as f64).abs() < 1e-12)
+        );
     }
 
     /// A 12 × 12 room joined by a 4 mm passage to a 40 × 40 one: the small room runs out of
