@@ -425,6 +425,34 @@ fn round_pocket_steps_in_by_the_concave_closed_form_and_holds_the_threshold() {
 }
 
 #[test]
+fn a_polygon_drawn_round_is_fitted_to_arcs_then_pocketed_as_a_circle() {
+    // A 400-gon of radius 40 (the chords 1.2 µm inside the circle): curve-fit-arcs within 2 µm
+    // turns it into a 349° arc and an 11° arc, and medial-trochoid cuts that as the circle it
+    // is. (A half circle is the most cavalier_contours takes per arc: the 349° one is handed
+    // over as two halves, else the pocket's nesting lost every level but the wall pass.)
+    let w = Work::new();
+    let mut poly = String::from("path,move,x,y,z\n");
+    for k in 0..=400 {
+        let a = f64::from(k % 400) * std::f64::consts::TAU / 400.0;
+        let mv = if k == 0 { "rapid" } else { "line" };
+        poly.push_str(&format!("1,{mv},{},{},0\n", 50.0 + 40.0 * a.cos(), 50.0 + 40.0 * a.sin()));
+    }
+    w.write("poly.csv", poly);
+    w.run("curve-fit-arcs", &["poly.csv", "--tol", "0.002", "-o", "arcs.csv"], b"").ok();
+    let arcs = w.read("arcs.csv");
+    assert!(arcs.lines().count() <= 4 && arcs.contains("ccw"), "{arcs}");
+    let args = ["arcs.csv", "--radius", "5", "--report", "r.json", "-o", "t.csv"];
+    w.run(BIN, &args, b"").ok();
+    let r = report(&w, "r.json");
+    assert_holds(&r, &w.read("t.csv"), 5.0);
+    let f = |k: &str| r[k].as_f64().unwrap_or_else(|| panic!("{k} in {r}"));
+    // Concentric passes from the wall (radius 35) in towards the centre at the concave step.
+    assert!(r["passes_per_layer"].as_u64().unwrap() > 30, "{r}");
+    assert!(f("trochoid_length_mm") < f("contour_length_mm"), "{r}");
+    assert!(f("time_ratio") < 0.5, "{r}");
+}
+
+#[test]
 fn material_over_the_threshold_after_the_plan_is_cleared_by_a_repair() {
     // A 20-gon of radius 15 (R5): the offset-only wall pass starts at the vertex at 0° and
     // its own start clears ahead of the last vertices before it, so their spokes are not

@@ -363,10 +363,21 @@ impl Contour {
     }
 
     /// The contour as a cavalier_contours polyline.
+    /// The contour as a cavalier_contours polyline. Cavalier takes arcs of at most a half
+    /// circle (|bulge| ≤ 1), so a larger arc goes in as its two halves.
     pub(crate) fn to_pline(&self) -> Polyline<f64> {
         let mut p = Polyline::with_capacity(self.vertices.len(), self.closed);
-        for v in &self.vertices {
-            p.add(v.p.x, v.p.y, v.bulge);
+        for (k, v) in self.vertices.iter().enumerate() {
+            let next = self.vertices.get(k + 1).or(self.closed.then(|| &self.vertices[0]));
+            match next {
+                Some(n) if v.bulge.abs() > 1.0 => {
+                    let half = (0.5 * v.bulge.atan()).tan();
+                    let mid = Seg::from_bulge(v.p, n.p, v.bulge).point_at(0.5);
+                    p.add(v.p.x, v.p.y, half);
+                    p.add(mid.x, mid.y, half);
+                }
+                _ => p.add(v.p.x, v.p.y, v.bulge),
+            }
         }
         p
     }
@@ -392,6 +403,33 @@ mod tests {
     /// (found by fuzzing `offset`) that leave their joint 174° apart and curl across each other
     /// just below it, and a line that turns straight back. Smooth and sharp joints that stay
     /// open do not.
+    /// A circle drawn as an arc of 349° and one of 11° (as curve-fit-arcs writes a 400-gon):
+    /// cavalier takes arcs of at most a half circle, so the large one goes in as two halves and
+    /// the winding number is right everywhere (it said 0 at points inside before).
+    #[test]
+    fn arcs_over_a_half_circle_wind_correctly() {
+        let c = P2::new(50.0, 50.0);
+        let at = |deg: f64| c + 40.0 * V2::new(deg.to_radians().cos(), deg.to_radians().sin());
+        let big = Seg::Arc(crate::geom::arc::Arc2 { c, r: 40.0, start: 0.0, sweep: 349f64.to_radians() });
+        let contour = Contour {
+            vertices: vec![
+                Vertex { p: at(0.0), bulge: big.bulge() },
+                Vertex { p: at(349.0), bulge: (11f64.to_radians() / 4.0).tan() },
+            ],
+            closed: true,
+        };
+        assert!(contour.vertices[0].bulge > 1.0);
+        for deg in (0..360).step_by(15) {
+            let inside = c + 39.0 * V2::new(f64::from(deg).to_radians().cos(), f64::from(deg).to_radians().sin());
+            let outside = c + 41.0 * V2::new(f64::from(deg).to_radians().cos(), f64::from(deg).to_radians().sin());
+            assert_eq!(contour.winding_number(&inside), 1, "{deg}°");
+            assert_eq!(contour.winding_number(&outside), 0, "{deg}°");
+        }
+        assert_eq!(contour.winding_number(&c), 1);
+        assert!((contour.area() - std::f64::consts::PI * 1600.0).abs() < 1e-9);
+        assert_eq!(contour.to_pline().vertex_data.len(), 3);
+    }
+
     #[test]
     fn consecutive_pieces_that_fold_across_each_other_cross() {
         let v = |x: f64, y: f64, bulge: f64| Vertex { p: P2::new(x, y), bulge };
