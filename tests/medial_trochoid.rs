@@ -450,6 +450,25 @@ fn a_polygon_drawn_round_is_fitted_to_arcs_then_pocketed_as_a_circle() {
     assert!(r["passes_per_layer"].as_u64().unwrap() > 30, "{r}");
     assert!(f("trochoid_length_mm") < f("contour_length_mm"), "{r}");
     assert!(f("time_ratio") < 0.5, "{r}");
+    assert_eq!(r["chord_drawn_paths"], serde_json::json!([]));
+    // Planned as drawn, a smaller such polygon (60 sides of 1.05 mm turning 6°, R2) is named as a
+    // curve drawn with chords, its line given, and the arcs suggested.
+    let mut poly = String::from("path,move,x,y,z\n");
+    for k in 0..=60 {
+        let a = f64::from(k % 60) * std::f64::consts::TAU / 60.0;
+        let mv = if k == 0 { "rapid" } else { "line" };
+        poly.push_str(&format!("7,{mv},{},{},0\n", 10.0 * a.cos(), 10.0 * a.sin()));
+    }
+    w.write("sixty.csv", poly);
+    let out = w.run(BIN, &["sixty.csv", "--radius", "2", "--report", "s.json", "-o", "s.csv"], b"");
+    assert_eq!(out.status, 0);
+    assert!(
+        out.stderr.contains("sixty.csv:2: path 7 is a curve drawn with chords (60 shallow joints"),
+        "{}",
+        out.stderr
+    );
+    assert!(out.stderr.contains("curve-fit-arcs"), "{}", out.stderr);
+    assert_eq!(report(&w, "s.json")["chord_drawn_paths"], serde_json::json!([7]));
 }
 
 #[test]

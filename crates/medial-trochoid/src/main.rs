@@ -250,6 +250,16 @@ fn run(args: Args) -> Result<()> {
     if let Some(given) = &args.analyse {
         return analyse_given(given, &regions, &settings, &args, started);
     }
+    let chorded = medial_trochoid::drawn_with_chords(&regions, r);
+    if let Some(&(first, run)) = chorded.first() {
+        let src = &sources[first];
+        cli::warn(&format!(
+            "{name}:{}: path {} is a curve drawn with chords ({run} shallow joints of lines shorter than R in a row; {} such loops): every pass along it gets a corner at each joint, all cleared by trochoids; fitted to arcs first (curve-fit-arcs --tol a little over the chords' sagitta | medial-trochoid -) it is cut by concentric passes",
+            src.line,
+            src.path,
+            chorded.len()
+        ));
+    }
     let leave_uncut = !(args.no_leave_uncut || args.allow_over_threshold);
     let planned = if leave_uncut { plan_leaving_uncut(&regions, &settings) } else { plan(&regions, &settings) };
     let plan = planned.map_err(|e| match e {
@@ -356,6 +366,7 @@ fn run(args: Args) -> Result<()> {
             .set("arc_sagitta_mm", settings.medial.sagitta)
             .set("medial_edges", medial_edges)
             .set("medial_equidistance_error_mm", plan.medial.iter().map(|m| m.equidistance_error).fold(0.0, f64::max))
+            .set("chord_drawn_paths", chorded.iter().map(|&(k, _)| sources[k].path).collect::<Vec<_>>())
             .set("danger_samples", plan.danger_samples)
             .set("danger_stretches", plan.danger.len())
             .set("trochoid_runs", plan.runs.len())
