@@ -12,6 +12,7 @@
 //! leaving uncut, and naming, the material no program reaches under the threshold.
 
 pub mod angles;
+pub mod chords;
 pub mod corner;
 pub mod engagement;
 pub mod feed;
@@ -20,6 +21,7 @@ pub mod medial;
 pub mod plot;
 pub mod program;
 pub mod relink;
+pub mod step;
 pub mod trochoid;
 pub mod uncut;
 
@@ -170,85 +172,6 @@ pub const ENGAGEMENT_ROUNDOFF_DEG: f64 = 1e-5;
 /// R(1 − cos threshold), the straight side cut at the threshold ([`side_cut_deg`]'s inverse).
 pub fn default_step(r: f64, threshold: f64) -> f64 {
     r * (1.0 - threshold.to_radians().cos())
-}
-
-/// Arcs of a pass tighter than this many tool radii are left to the trochoids like corners: the
-/// step after a pass is limited only by its arcs of radius R or more, which keeps it at least
-/// half the straight side cut's ([`corner::concave_step`] at ρ = R, within 1 %).
-pub const STEP_ARCS_FROM: f64 = 0.125;
-
-/// The step after a pass whose loops (oriented as a region: material to the right of travel
-/// when cut) are `loops`: `s.step`, or less where the loops curve round the pocket. A pass
-/// along an arc of radius ρ centred on the pocket's side cuts outward from the concentric pass
-/// a step inside it at acos(1 − s/R − s/ρ + s²/(2ρR)), more than the straight side cut's, so
-/// the step is the largest that holds the threshold on the pass's tightest such arc of radius
-/// R × [`STEP_ARCS_FROM`] or more.
-pub fn step_after(loops: &[camkit::contour::Contour], s: &Settings) -> f64 {
-    let tightest = loops
-        .iter()
-        .flat_map(|c| c.segs())
-        .filter_map(|g| match g {
-            camkit::contour::Seg::Arc(a) if a.sweep > 0.0 && a.r >= STEP_ARCS_FROM * s.radius => Some(a.r),
-            _ => None,
-        })
-        .reduce(f64::min);
-    tightest.map_or(s.step, |rho| s.step.min(corner::concave_step(s.radius, rho, s.threshold.to_radians())))
-}
-
-/// A joint between two lines shorter than R that turns by less than this (degrees) is a curve
-/// drawn with chords, not a corner.
-pub const CHORD_TURN_DEG: f64 = 10.0;
-
-/// The most consecutive joints of `c` (closed) that look like a curve drawn with chords: between
-/// lines shorter than `r`, all turning the same way by less than [`CHORD_TURN_DEG`]. Every such
-/// joint is a corner of every pass along it, and each corner is dangerous (a pass round it cuts
-/// outward like the concave side cut), so the loops clear all of them; the same curve fitted to
-/// arcs (curve-fit-arcs) is cut by concentric passes at the concave step instead.
-pub fn chord_run(c: &camkit::contour::Contour, r: f64) -> usize {
-    let segs: Vec<camkit::contour::Seg> = c.segs().collect();
-    let n = segs.len();
-    let limit = CHORD_TURN_DEG.to_radians().sin();
-    // The signed turn at the joint after piece k, if it joins two short lines.
-    let turn = |k: usize| match (segs[k], segs[(k + 1) % n]) {
-        (camkit::contour::Seg::Line(a, b), camkit::contour::Seg::Line(_, d))
-            if (b - a).norm() < r && (d - b).norm() < r =>
-        {
-            let (u, v) = ((b - a).normalize(), (d - b).normalize());
-            let t = camkit::geom::cross2(&u, &v);
-            (u.dot(&v) > 0.0 && t.abs() < limit && t != 0.0).then_some(t.signum())
-        }
-        _ => None,
-    };
-    let turns: Vec<Option<f64>> = (0..n).map(turn).collect();
-    let (mut best, mut run, mut sign) = (0, 0, 0.0);
-    // Twice round, so that a run through the loop's start counts whole.
-    for k in 0..2 * n {
-        match turns[k % n] {
-            Some(t) if t == sign => run += 1,
-            Some(t) => (run, sign) = (1, t),
-            None => (run, sign) = (0, 0.0),
-        }
-        best = best.max(run.min(n));
-    }
-    best
-}
-
-/// Runs of [`chord_run`] this long or longer make a loop a curve drawn with chords.
-pub const CHORD_RUN_MIN: usize = 12;
-
-/// The loops of `regions` drawn with chords (a [`chord_run`] of [`CHORD_RUN_MIN`] or more for a
-/// tool of radius `r`): (the loop's index in the input, the run).
-pub fn drawn_with_chords(regions: &[Region], r: f64) -> Vec<(usize, usize)> {
-    let mut out: Vec<(usize, usize)> = regions
-        .iter()
-        .flat_map(|g| {
-            std::iter::once((&g.outer, g.outer_source)).chain(g.islands.iter().zip(g.island_sources.iter().copied()))
-        })
-        .map(|(c, source)| (source, chord_run(c, r)))
-        .filter(|&(_, run)| run >= CHORD_RUN_MIN)
-        .collect();
-    out.sort_unstable();
-    out
 }
 
 /// Engagement of a straight side cut at radial depth `step` with a tool of radius `r`
@@ -472,7 +395,7 @@ fn plan_in(regions: &[Region], walls: &[Region], s: &Settings) -> Result<Plan, P
         direction: Direction::Climb,
         offset: OffsetOptions::default(),
     };
-    let rule = |loops: &[camkit::contour::Contour]| step_after(loops, s);
+    let rule = |loops: &[camkit::contour::Contour]| step::step_after(loops, s);
     let pocket = pocket_stepped(regions, &opts, Some(&rule))
         .map_err(|e| PlanError::Pocket(format!("offset {} mm: {}", e.distance, e.error)))?;
     if pocket.passes.is_empty() {
@@ -1041,73 +964,6 @@ mod tests {
         assert!((side_cut_deg(2.0, 1.2) - 0.4f64.acos().to_degrees()).abs() < 1e-12);
         assert_eq!(side_cut_deg(2.0, 4.0), 180.0);
         assert_eq!(side_cut_deg(2.0, 5.0), 180.0);
-    }
-
-    #[test]
-    fn the_step_after_a_pass_follows_its_tightest_arc_round_the_pocket() {
-        use camkit::contour::Contour;
-        let s = Settings {
-            radius: 4.0,
-            step: default_step(4.0, 40.0),
-            threshold: 40.0,
-            trochoid_radius: 2.0,
-            pitch: None,
-            allowance: 0.0,
-            corner_radius: None,
-            sample: 0.5,
-            medial: MedialOptions::default(),
-            feed: FeedModel { spindle: 4800.0, teeth: 6.0, chip: 0.03, fz_max: 0.1, force_at: Some(40.0) },
-        };
-        let phi = 40f64.to_radians();
-        let square =
-            Contour::polygon(&[P2::new(0.0, 0.0), P2::new(9.0, 0.0), P2::new(9.0, 9.0), P2::new(0.0, 9.0)], true);
-        // Straight sides: the given step.
-        assert_eq!(step_after(std::slice::from_ref(&square), &s), s.step);
-        // A pass round a circle of radius 10 (counter-clockwise: the pocket's side), and an island's
-        // loop (clockwise: it curves away from the material) of radius 3.
-        let round = Contour::circle(P2::new(50.0, 0.0), 10.0, 0.0, true);
-        let island = Contour::circle(P2::new(50.0, 0.0), 3.0, 0.0, false);
-        let step = step_after(&[square.clone(), round.clone(), island], &s);
-        assert!((step - corner::concave_step(4.0, 10.0, phi)).abs() < 1e-15);
-        assert!((corner::concave_engagement(4.0, 10.0, step) - phi).abs() < 1e-12);
-        // The tightest arc decides, down to R/8; tighter ones are left to the trochoids.
-        let tight = Contour::circle(P2::new(0.0, 50.0), 0.6, 0.0, true);
-        let step = step_after(&[round.clone(), tight], &s);
-        assert!((step - corner::concave_step(4.0, 0.6, phi)).abs() < 1e-15);
-        let tighter = Contour::circle(P2::new(0.0, 50.0), 0.49, 0.0, true);
-        assert_eq!(step_after(&[round.clone(), tighter], &s), corner::concave_step(4.0, 10.0, phi));
-        // A step given under the concave one stays.
-        let small = Settings { step: 0.2, ..s };
-        assert_eq!(step_after(&[round], &small), 0.2);
-    }
-
-    #[test]
-    fn curves_drawn_with_chords_are_told_from_corners() {
-        use camkit::contour::Contour;
-        let ngon = |n: usize, radius: f64| {
-            let pts: Vec<P2> = (0..n)
-                .map(|k| {
-                    let a = k as f64 * std::f64::consts::TAU / n as f64;
-                    P2::new(radius * a.cos(), radius * a.sin())
-                })
-                .collect();
-            Contour::polygon(&pts, true)
-        };
-        // A 100-gon of radius 40: sides of 2.5 mm turning 3.6° each, all the way round.
-        assert_eq!(chord_run(&ngon(100, 40.0), 5.0), 100);
-        assert_eq!(chord_run(&ngon(100, 40.0).reversed(), 5.0), 100);
-        // Sides of 2.5 mm are not short for a tool of radius 2; a 24-gon turns 15° at each corner.
-        assert_eq!(chord_run(&ngon(100, 40.0), 2.0), 0);
-        assert_eq!(chord_run(&ngon(24, 5.0), 5.0), 0);
-        // A square with its top drawn through nine points of a shallow bow 1 mm apart: the 8
-        // joints of the short lines from the second point on (the first line, from the
-        // square's corner, is long).
-        let mut pts = vec![P2::new(0.0, 0.0), P2::new(10.0, 0.0)];
-        pts.extend(
-            (1..10).map(|k| P2::new(10.0 - f64::from(k), 10.0 + (f64::from(k) * 0.1 * std::f64::consts::PI).sin())),
-        );
-        pts.extend([P2::new(0.0, 10.0)]);
-        assert_eq!(chord_run(&Contour::polygon(&pts, true), 5.0), 8);
     }
 
     #[test]

@@ -250,7 +250,7 @@ fn run(args: Args) -> Result<()> {
     if let Some(given) = &args.analyse {
         return analyse_given(given, &regions, &settings, &args, started);
     }
-    let chorded = medial_trochoid::drawn_with_chords(&regions, r);
+    let chorded = medial_trochoid::chords::drawn_with_chords(&regions, r);
     if let Some(&(first, run)) = chorded.first() {
         let src = &sources[first];
         cli::warn(&format!(
