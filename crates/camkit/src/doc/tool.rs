@@ -40,9 +40,27 @@ pub struct Tool {
     /// Length from the gauge line to the tip (mm).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub length: Option<f64>,
-    /// Tool number for the tool change (T word).
+    /// Tool number for the tool change (T word) and the length offset (H word).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub number: Option<u32>,
+    /// Spindle speed (rpm) the tool cuts at; none for a non-rotating tool.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub spindle_speed: Option<f64>,
+    /// Feed per tooth (mm): the cutting feed is feed_per_tooth × flutes × spindle_speed.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub feed_per_tooth: Option<f64>,
+    /// Cutting feed (mm/min), when given directly instead of per tooth.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub feed: Option<f64>,
+    /// Feed (mm/min) of plunges and ramps into material.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub plunge_feed: Option<f64>,
+    /// Diameter of the holder above the gauge line (mm).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub holder_diameter: Option<f64>,
+    /// Length of the holder above the gauge line (mm).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub holder_length: Option<f64>,
     /// Included angle of a flat-type non-rotating tool's edge between its two flanks (degrees);
     /// paper 000 grinds it 5° below the model's corner angle to keep the second flank clear.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -82,6 +100,34 @@ impl Tool {
         if self.length.is_some_and(|l| !positive(l)) {
             return Err(field_error(file, "length", "length must be positive"));
         }
+        for (name, v) in [
+            ("spindle_speed", self.spindle_speed),
+            ("feed_per_tooth", self.feed_per_tooth),
+            ("feed", self.feed),
+            ("plunge_feed", self.plunge_feed),
+            ("holder_diameter", self.holder_diameter),
+            ("holder_length", self.holder_length),
+        ] {
+            if v.is_some_and(|v| !positive(v)) {
+                return Err(field_error(
+                    file,
+                    name,
+                    format!("{name} must be a positive number, got {}", v.unwrap_or(0.0)),
+                ));
+            }
+        }
+        if self.feed.is_some() && self.feed_per_tooth.is_some() {
+            return Err(field_error(file, "feed", "give feed or feed_per_tooth, not both"));
+        }
+        if self.feed_per_tooth.is_some() && (self.flutes.is_none() || self.spindle_speed.is_none()) {
+            return Err(field_error(file, "feed_per_tooth", "feed_per_tooth needs flutes and spindle_speed"));
+        }
+        if self.holder_diameter.is_some() != self.holder_length.is_some() {
+            return Err(field_error(file, "holder_diameter", "give holder_diameter and holder_length together"));
+        }
+        if self.holder_diameter.is_some() && self.length.is_none() {
+            return Err(field_error(file, "length", "a holder needs the tool's length (gauge line to tip)"));
+        }
         if self.included_angle.is_some_and(|a| !(a > 0.0 && a < 180.0)) {
             return Err(field_error(file, "included_angle", "included_angle must be between 0 and 180 degrees"));
         }
@@ -98,6 +144,11 @@ impl Tool {
             }
         }
         Ok(())
+    }
+
+    /// The cutting feed (mm/min): `feed`, or feed per tooth × flutes × spindle speed.
+    pub fn cutting_feed(&self) -> Option<f64> {
+        self.feed.or_else(|| Some(self.feed_per_tooth? * f64::from(self.flutes?) * self.spindle_speed?))
     }
 
     /// Reads and validates a tool document.
@@ -137,5 +188,28 @@ mod tests {
         assert!(e.to_string().contains("(included_angle)"), "{e}");
         let e = parse(r#"{"kind": "cylindrical-nonrotating", "radius": 12.5, "tilt_range": [0, -20]}"#).unwrap_err();
         assert!(e.to_string().contains("(tilt_range)"), "{e}");
+    }
+
+    #[test]
+    fn feeds_and_holder() {
+        let t = parse(r#"{"kind": "flat", "radius": 4, "flutes": 3, "spindle_speed": 8000, "feed_per_tooth": 0.05}"#)
+            .unwrap();
+        assert!((t.cutting_feed().unwrap() - 1200.0).abs() < 1e-9);
+        let t = parse(r#"{"kind": "flat", "radius": 4, "feed": 900}"#).unwrap();
+        assert_eq!(t.cutting_feed(), Some(900.0));
+        assert_eq!(parse(r#"{"kind": "flat", "radius": 4}"#).unwrap().cutting_feed(), None);
+        let e = parse(r#"{"kind": "flat", "radius": 4, "feed_per_tooth": 0.05}"#).unwrap_err();
+        assert!(e.to_string().contains("needs flutes and spindle_speed"), "{e}");
+        let e = parse(
+            r#"{"kind": "flat", "radius": 4, "feed": 900, "feed_per_tooth": 0.05, "flutes": 2, "spindle_speed": 1}"#,
+        )
+        .unwrap_err();
+        assert!(e.to_string().contains("not both"), "{e}");
+        let e = parse(r#"{"kind": "flat", "radius": 4, "plunge_feed": -3}"#).unwrap_err();
+        assert_eq!(e.to_string(), "t.json (plunge_feed): plunge_feed must be a positive number, got -3");
+        let e = parse(r#"{"kind": "flat", "radius": 4, "holder_diameter": 30}"#).unwrap_err();
+        assert!(e.to_string().contains("together"), "{e}");
+        let e = parse(r#"{"kind": "flat", "radius": 4, "holder_diameter": 30, "holder_length": 40}"#).unwrap_err();
+        assert!(e.to_string().contains("(length)"), "{e}");
     }
 }
