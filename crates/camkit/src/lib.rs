@@ -7,6 +7,7 @@
 //! [`report`]), and SVG plots ([`svg`]). Nothing here is specific to one filter.
 
 pub mod cli;
+pub mod collide;
 pub mod contour;
 pub mod doc;
 pub mod dxf;

@@ -227,22 +227,14 @@ fn run(args: Args) -> Result<()> {
     };
     let input = Input::open(&args.io.input)?;
     let name = input.name.clone();
-    let sources = if name.to_ascii_lowercase().ends_with(".dxf") {
-        let read = camkit::dxf::read(&name, &String::from_utf8_lossy(&input.data))?;
-        if let Some((kind, line)) = read.skipped.first() {
-            cli::warn(&format!(
-                "{name}: {} entities that are not contours skipped (the first: {kind} at line {line})",
-                read.skipped.len()
-            ));
-        }
-        read.sources
-    } else {
-        let table = table::read(&input, &[Col::X, Col::Y])?;
-        if table.rows.is_empty() {
-            return Err(Error::input("no rows: no contour to pocket").at(Location::file(&name)));
-        }
-        contour_table::read(&table, &name)?.sources
-    };
+    let loaded = camkit::contour::load::contours(&input)?;
+    if let Some((kind, line)) = loaded.skipped.first() {
+        cli::warn(&format!(
+            "{name}: {} entities that are not contours skipped (the first: {kind} at line {line})",
+            loaded.skipped.len()
+        ));
+    }
+    let sources = loaded.sources;
     if sources.is_empty() {
         return Err(Error::input("no closed contour in the input").at(Location::file(&name)));
     }

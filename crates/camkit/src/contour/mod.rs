@@ -8,11 +8,14 @@
 //! nest into [`region::Region`]s (an outer boundary with islands) and [`pocket`] turns regions into
 //! contour-parallel passes in machining order.
 
+pub mod load;
 pub mod offset;
 pub mod pocket;
 pub mod region;
 pub mod table;
 mod verify;
+
+pub(crate) use verify::SegSet;
 
 pub use offset::{Offset, OffsetError, OffsetOptions, offset_contour, offset_region};
 pub use verify::{Check, Defect};

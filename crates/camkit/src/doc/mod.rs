@@ -4,8 +4,10 @@
 pub mod frame;
 pub mod machine;
 pub mod model;
+pub mod setup;
 pub mod tool;
 
 pub use frame::Frame;
 pub use machine::Machine;
+pub use setup::{Job, Setup};
 pub use tool::{Tool, ToolKind};

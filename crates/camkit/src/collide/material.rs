@@ -1,0 +1,395 @@
+//! The stock a program has not cut yet, as a height map: nodes on a square grid over the stock's
+//! outline, each holding the top of the material above it (none outside the outline). A cut by a
+//! vertical tool lowers every node under the tool's bottom to the lowest height the bottom passes
+//! at; rapids are measured against the nodes under the tool's footprint.
+//!
+//! The map is conservative where it approximates: a cut's lowest height over a node is an
+//! evaluated value of the true minimum (never below it), so material is never taken away that the
+//! tool did not remove at a node. Between nodes the map knows nothing: material narrower than
+//! the spacing can pass unseen, which is why the spacing is a setup figure and the part itself
+//! (walls, model) is checked exactly elsewhere.
+
+use crate::contour::Seg;
+use crate::doc::setup::Stock;
+use crate::doc::tool::{Tool, ToolKind};
+use crate::geom::P2;
+
+/// The bottom of a rotating tool seen along a vertical axis: a flat of radius `radius − corner`
+/// and a torus of radius `corner` round it (flat end mill: corner 0; ball: corner = radius).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Cutter {
+    /// Radius R (mm).
+    pub radius: f64,
+    /// Corner radius (mm), 0 ≤ corner ≤ radius.
+    pub corner: f64,
+}
+
+impl Cutter {
+    /// The cutter of a tool document (non-rotating tools as flat cylinders of their radius).
+    pub fn of(tool: &Tool) -> Cutter {
+        let corner = match tool.kind {
+            ToolKind::Ball => tool.radius,
+            ToolKind::Bull => tool.corner_radius,
+            _ => 0.0,
+        };
+        Cutter { radius: tool.radius, corner }
+    }
+
+    /// Height of the tool's bottom above its tip at horizontal distance `rho` from the axis
+    /// (+∞ beyond the radius).
+    pub fn lift(&self, rho: f64) -> f64 {
+        let flat = self.radius - self.corner;
+        if rho <= flat {
+            0.0
+        } else if rho <= self.radius {
+            let d = rho - flat;
+            self.corner - (self.corner * self.corner - d * d).max(0.0).sqrt()
+        } else {
+            f64::INFINITY
+        }
+    }
+}
+
+/// The remaining stock.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Material {
+    origin: P2,
+    step: f64,
+    nx: usize,
+    ny: usize,
+    /// Top of the material at each node (row-major in y); −∞ where there is none.
+    top: Vec<f64>,
+    bottom: f64,
+}
+
+/// Golden-section steps of a ramp's lowest passage over a node.
+const GOLDEN_STEPS: usize = 40;
+
+impl Material {
+    /// The uncut stock on a grid of `step` mm; `Err` with the node count if it would exceed
+    /// `max_nodes`.
+    pub fn new(stock: &Stock, step: f64, max_nodes: usize) -> Result<Material, usize> {
+        if !step.is_finite() || step <= 0.0 {
+            return Err(usize::MAX);
+        }
+        let (lo, hi) = stock.extent();
+        let nx = ((hi[0] - lo[0]) / step).floor() as usize + 1;
+        let ny = ((hi[1] - lo[1]) / step).floor() as usize + 1;
+        let n = nx.saturating_mul(ny);
+        if n > max_nodes {
+            return Err(n);
+        }
+        let origin = P2::new(lo[0], lo[1]);
+        let top = (0..n)
+            .map(|k| {
+                let p = origin + nalgebra::Vector2::new((k % nx) as f64 * step, (k / nx) as f64 * step);
+                if stock.covers(p.x, p.y) { stock.top() } else { f64::NEG_INFINITY }
+            })
+            .collect();
+        Ok(Material { origin, step, nx, ny, top, bottom: stock.bottom() })
+    }
+
+    /// Node spacing (mm).
+    pub fn step(&self) -> f64 {
+        self.step
+    }
+
+    /// Number of nodes.
+    pub fn nodes(&self) -> usize {
+        self.top.len()
+    }
+
+    /// Bottom of the stock.
+    pub fn bottom(&self) -> f64 {
+        self.bottom
+    }
+
+    fn node(&self, i: usize, j: usize) -> P2 {
+        self.origin + nalgebra::Vector2::new(i as f64 * self.step, j as f64 * self.step)
+    }
+
+    /// Index ranges of the nodes inside the box `lo`..`hi` (empty ranges when it misses the map).
+    fn span(&self, lo: P2, hi: P2) -> (std::ops::Range<usize>, std::ops::Range<usize>) {
+        let range = |a: f64, b: f64, o: f64, n: usize| {
+            let i0 = ((a - o) / self.step).ceil().max(0.0);
+            let i1 = ((b - o) / self.step).floor();
+            if i1.is_nan() || i1 < 0.0 || i0 > i1 || i0 >= n as f64 {
+                return 0..0;
+            }
+            i0 as usize..(i1 as usize).min(n - 1) + 1
+        };
+        (range(lo.x, hi.x, self.origin.x, self.nx), range(lo.y, hi.y, self.origin.y, self.ny))
+    }
+
+    /// Nodes within `reach` of the piece's bounds.
+    fn near(&self, piece: &Seg, reach: f64) -> impl Iterator<Item = (usize, P2)> + '_ {
+        let (lo, hi) = piece.bounds();
+        let (xs, ys) = self.span(P2::new(lo.x - reach, lo.y - reach), P2::new(hi.x + reach, hi.y + reach));
+        ys.flat_map(move |j| xs.clone().map(move |i| (j * self.nx + i, self.node(i, j))))
+    }
+
+    /// Top of the material at the node nearest `p` (−∞ where there is none).
+    pub fn top_near(&self, p: &P2) -> f64 {
+        let i = ((p.x - self.origin.x) / self.step).round();
+        let j = ((p.y - self.origin.y) / self.step).round();
+        if i < 0.0 || j < 0.0 || i >= self.nx as f64 || j >= self.ny as f64 {
+            return f64::NEG_INFINITY;
+        }
+        self.top[j as usize * self.nx + i as usize]
+    }
+
+    /// The tool with its tip going from height `z0` to `z1` (linearly along the piece) over the
+    /// XY piece cuts the material under its bottom.
+    pub fn cut(&mut self, cutter: &Cutter, piece: &Seg, z0: f64, z1: f64) {
+        let r = cutter.radius;
+        let nodes: Vec<(usize, P2)> = self.near(piece, r).collect();
+        for (k, p) in nodes {
+            if self.top[k] == f64::NEG_INFINITY {
+                continue;
+            }
+            let low = lowest_pass(cutter, piece, z0, z1, &p);
+            if low < self.top[k] {
+                self.top[k] = low;
+            }
+        }
+    }
+
+    /// Smallest height of a flat-bottomed footprint of `radius` above the material, the
+    /// footprint's bottom going from `z0` to `z1` (linearly) over the XY piece: over every node
+    /// within `radius` of the piece, the lowest the bottom is while the node is under it, less the
+    /// node's top. `None` if no material lies under the footprint. Also returns the node.
+    pub fn clearance(&self, piece: &Seg, z0: f64, z1: f64, radius: f64) -> Option<(f64, P2)> {
+        let mut best: Option<(f64, P2)> = None;
+        for (k, p) in self.near(piece, radius) {
+            let top = self.top[k];
+            if top == f64::NEG_INFINITY {
+                continue;
+            }
+            let Some((t0, t1)) = under(piece, &p, radius) else { continue };
+            let z = (z0 + (z1 - z0) * t0).min(z0 + (z1 - z0) * t1);
+            let c = z - top;
+            if best.is_none_or(|(b, _)| c < b) {
+                best = Some((c, p));
+            }
+        }
+        best
+    }
+
+    /// Highest material within `radius` of the XY point `p` (−∞ if none).
+    pub fn highest_within(&self, p: &P2, radius: f64) -> f64 {
+        self.highest_along(&Seg::Line(*p, *p), radius)
+    }
+
+    /// Highest material within `radius` of the XY piece (−∞ if none).
+    pub fn highest_along(&self, piece: &Seg, radius: f64) -> f64 {
+        self.near(piece, radius)
+            .filter(|(_, q)| piece.distance_to(q) <= radius)
+            .map(|(k, _)| self.top[k])
+            .fold(f64::NEG_INFINITY, f64::max)
+    }
+}
+
+/// The range of fractions of `piece` during which `p` lies within `radius` of the point of the
+/// piece at that fraction (one interval: exact for a line, the hull of the arcs' interval for an
+/// arc, which only widens it).
+fn under(piece: &Seg, p: &P2, radius: f64) -> Option<(f64, f64)> {
+    match piece {
+        Seg::Line(a, b) => {
+            let d = b - a;
+            let l2 = d.norm_squared();
+            if l2 == 0.0 {
+                return ((p - a).norm() <= radius).then_some((0.0, 1.0));
+            }
+            // |a + t d − p|² ≤ r²: a quadratic in t.
+            let w = a - p;
+            let (qa, qb, qc) = (l2, 2.0 * w.dot(&d), w.norm_squared() - radius * radius);
+            let disc = qb * qb - 4.0 * qa * qc;
+            if disc < 0.0 {
+                return None;
+            }
+            let s = disc.sqrt();
+            let (t0, t1) = ((-qb - s) / (2.0 * qa), (-qb + s) / (2.0 * qa));
+            let (t0, t1) = (t0.max(0.0), t1.min(1.0));
+            (t0 <= t1).then_some((t0, t1))
+        }
+        Seg::Arc(arc) => {
+            if piece.distance_to(p) > radius {
+                return None;
+            }
+            // The fractions where the arc is within reach form at most two intervals: take the
+            // hull of the sampled fractions inside, widened by one sample step either side.
+            let n = 64;
+            let inside: Vec<usize> =
+                (0..=n).filter(|&k| (arc.point_at_fraction(k as f64 / n as f64) - p).norm() <= radius).collect();
+            match (inside.first(), inside.last()) {
+                (Some(&f), Some(&l)) => {
+                    Some(((f as f64 - 1.0).max(0.0) / n as f64, ((l as f64 + 1.0) / n as f64).min(1.0)))
+                }
+                _ => Some((0.0, 1.0)),
+            }
+        }
+    }
+}
+
+/// The lowest height the cutter's bottom reaches over `p` while its tip runs over the piece from
+/// `z0` to `z1` (+∞ if it never covers `p`). A value of the function evaluated at some fractions:
+/// never below the true minimum.
+fn lowest_pass(cutter: &Cutter, piece: &Seg, z0: f64, z1: f64, p: &P2) -> f64 {
+    let at = |t: f64| {
+        let q = piece.point_at(t);
+        z0 + (z1 - z0) * t + cutter.lift((q - p).norm())
+    };
+    let nearest = nearest_fraction(piece, p);
+    let best = at(nearest);
+    if z0 == z1 {
+        return best;
+    }
+    let Some((t0, t1)) = under(piece, p, cutter.radius) else { return f64::INFINITY };
+    match piece {
+        // Over the fractions where a line's tool covers `p` the height is a linear term plus a
+        // convex function of a convex distance: unimodal, so golden-section search finds it.
+        Seg::Line(..) => {
+            let g = 0.5 * (5f64.sqrt() - 1.0);
+            let (mut a, mut b) = (t0, t1);
+            let (mut c, mut d) = (b - g * (b - a), a + g * (b - a));
+            let (mut fc, mut fd) = (at(c), at(d));
+            for _ in 0..GOLDEN_STEPS {
+                if fc <= fd {
+                    b = d;
+                    d = c;
+                    fd = fc;
+                    c = b - g * (b - a);
+                    fc = at(c);
+                } else {
+                    a = c;
+                    c = d;
+                    fc = fd;
+                    d = a + g * (b - a);
+                    fd = at(d);
+                }
+            }
+            best.min(fc).min(fd).min(at(t0)).min(at(t1))
+        }
+        // A helix: samples over the fractions that may cover `p`.
+        Seg::Arc(_) => {
+            (0..=ARC_SAMPLES).map(|k| at(t0 + (t1 - t0) * k as f64 / ARC_SAMPLES as f64)).fold(best, f64::min)
+        }
+    }
+}
+
+/// Samples of a helical cut over a node.
+const ARC_SAMPLES: usize = 64;
+
+/// Fraction of the piece's point nearest `p`.
+fn nearest_fraction(piece: &Seg, p: &P2) -> f64 {
+    match piece {
+        Seg::Line(a, b) => {
+            let d = b - a;
+            let l2 = d.norm_squared();
+            if l2 > 0.0 { ((p - a).dot(&d) / l2).clamp(0.0, 1.0) } else { 0.0 }
+        }
+        Seg::Arc(arc) => {
+            let phi = crate::geom::arc::angle_of(&(p - arc.c));
+            if arc.spans(phi) && (p - arc.c).norm() > 0.0 {
+                arc.progress(phi) / arc.sweep.abs()
+            } else if (arc.start_point() - p).norm() <= (arc.end_point() - p).norm() {
+                0.0
+            } else {
+                1.0
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geom::{Arc2, P3};
+    use proptest::prelude::*;
+
+    fn block() -> Stock {
+        Stock::Box { min: P3::new(0.0, 0.0, -20.0), max: P3::new(40.0, 30.0, 0.0) }
+    }
+
+    #[test]
+    fn a_flat_slot_lowers_exactly_the_nodes_within_r() {
+        let mut m = Material::new(&block(), 0.5, 1 << 20).unwrap();
+        let flat = Cutter { radius: 4.0, corner: 0.0 };
+        m.cut(&flat, &Seg::Line(P2::new(10.0, 15.0), P2::new(30.0, 15.0)), -5.0, -5.0);
+        assert_eq!(m.top_near(&P2::new(20.0, 19.0)), -5.0);
+        assert_eq!(m.top_near(&P2::new(20.0, 19.5)), 0.0);
+        assert_eq!(m.top_near(&P2::new(6.0, 15.0)), -5.0);
+        assert_eq!(m.top_near(&P2::new(5.5, 15.0)), 0.0);
+        // A footprint inside the slot sees its floor; one touching the side sees the stock top.
+        assert_eq!(m.highest_within(&P2::new(20.0, 15.0), 4.0), -5.0);
+        assert_eq!(m.highest_within(&P2::new(20.0, 15.5), 4.0), 0.0);
+        // A rapid across at −2 over the slot clears its floor by 3 and runs into the top beside it.
+        let (c, _) = m.clearance(&Seg::Line(P2::new(20.0, 15.0), P2::new(20.0, 15.0)), 1.0, -4.0, 4.0).unwrap();
+        assert_eq!(c, 1.0);
+        let (c, at) = m.clearance(&Seg::Line(P2::new(12.0, 15.0), P2::new(12.0, 25.0)), -2.0, -2.0, 4.0).unwrap();
+        assert_eq!(c, -2.0);
+        assert_eq!(m.top_near(&at), 0.0, "{at:?}");
+        // Outside the stock there is nothing.
+        assert!(m.clearance(&Seg::Line(P2::new(50.0, 15.0), P2::new(60.0, 15.0)), -10.0, -10.0, 4.0).is_none());
+    }
+
+    #[test]
+    fn a_ball_leaves_its_own_section() {
+        let mut m = Material::new(&block(), 0.25, 1 << 20).unwrap();
+        let ball = Cutter { radius: 3.0, corner: 3.0 };
+        m.cut(&ball, &Seg::Line(P2::new(5.0, 15.0), P2::new(35.0, 15.0)), -3.0, -3.0);
+        for dy in [0.0, 1.0, 2.0, 2.5] {
+            let want = -3.0 + 3.0 - (9.0f64 - dy * dy).sqrt();
+            assert!((m.top_near(&P2::new(20.0, 15.0 + dy)) - want).abs() < 1e-12, "{dy}");
+        }
+    }
+
+    #[test]
+    fn a_helix_lowers_no_node_below_its_path() {
+        // A flat end mill ramping round a circle: a node on the circle at fraction t is cut to
+        // z(t) exactly (the tip passes over it); none lower than the ramp's lowest height.
+        let mut m = Material::new(&block(), 0.5, 1 << 20).unwrap();
+        let flat = Cutter { radius: 2.0, corner: 0.0 };
+        let arc = Seg::Arc(Arc2 { c: P2::new(20.0, 15.0), r: 5.0, start: 0.0, sweep: std::f64::consts::TAU });
+        m.cut(&flat, &arc, 0.0, -4.0);
+        let centre = m.top_near(&P2::new(20.0, 15.0));
+        assert_eq!(centre, 0.0, "the circle's centre is 5 from the path, beyond R");
+        let low = (0..m.nodes()).map(|k| m.top[k]).fold(f64::INFINITY, f64::min);
+        assert!(low >= -4.0 - 1e-12, "{low}");
+        // The node at angle 0 is under the tip at the start and at the end: the end is lower.
+        assert!((m.top_near(&P2::new(25.0, 15.0)) + 4.0).abs() < 1e-9, "{}", m.top_near(&P2::new(25.0, 15.0)));
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig { cases: 64, ..ProptestConfig::default() })]
+
+        /// A straight ramp's cut over each node agrees with the brute-force minimum over 20 000
+        /// positions of the tool along the move, within the height the ramp drops between two of
+        /// them (the brute force's own resolution).
+        #[test]
+        fn ramp_cuts_match_brute_force(
+            ax in 5.0f64..35.0, ay in 5.0f64..25.0, bx in 5.0f64..35.0, by in 5.0f64..25.0,
+            z0 in -10.0f64..0.0, z1 in -10.0f64..0.0, corner in 0.0f64..1.0,
+        ) {
+            let cutter = Cutter { radius: 3.0, corner: 3.0 * corner };
+            let piece = Seg::Line(P2::new(ax, ay), P2::new(bx, by));
+            let mut m = Material::new(&block(), 0.5, 1 << 20).unwrap();
+            m.cut(&cutter, &piece, z0, z1);
+            let n = 4_000;
+            let slack = (z1 - z0).abs() / n as f64 + 1e-6;
+            for (k, p) in m.near(&piece, 3.0).collect::<Vec<_>>() {
+                // A node the tool's rim only grazes is under it at one fraction, which samples miss.
+                if (piece.distance_to(&p) - 3.0).abs() < 1e-6 {
+                    continue;
+                }
+                let brute = (0..=n)
+                    .map(|i| {
+                        let t = i as f64 / n as f64;
+                        z0 + (z1 - z0) * t + cutter.lift((piece.point_at(t) - p).norm())
+                    })
+                    .fold(0.0f64, f64::min);
+                prop_assert!((m.top[k] - brute).abs() <= slack, "node {p:?}: {} vs {brute}", m.top[k]);
+            }
+        }
+    }
+}
