@@ -7,6 +7,8 @@
 //! dialect ([`nc`]), and read back through the forward kinematics to measure what it really does
 //! ([`readback`]).
 
+pub mod collision;
+pub mod link;
 pub mod nc;
 pub mod plan;
 pub mod readback;
@@ -87,7 +89,7 @@ pub fn cl_rows(
         if f.is_none() && !rapid {
             return Err(Error::input("no feed for this move: give the f column or --feed").at(at(row.line, "f")));
         }
-        out.push(Cl { tip: row.pos, axis: row.axis / n, s: row.s, feed: f, rapid, line: row.line });
+        out.push(Cl { tip: row.pos, axis: row.axis / n, s: row.s, feed: f, rapid, reorient: rapid, line: row.line });
     }
     if out.is_empty() {
         return Err(Error::input("no rows: nothing to post").at(Location::file(file)));
@@ -237,7 +239,7 @@ mod tests {
                 let (th, ph) = ((tilt * (0.3 + 0.7 * t)).to_radians(), (turn * t).to_radians());
                 let axis = V3::new(th.sin() * ph.cos(), th.sin() * ph.sin(), th.cos());
                 let s = with_s.then_some(90.0 * t);
-                Cl { tip, axis, s, feed: Some(600.0), rapid: k == 0, line: k as u64 + 2 }
+                Cl { tip, axis, s, feed: Some(600.0), rapid: k == 0, reorient: k == 0, line: k as u64 + 2 }
             })
             .collect()
     }
@@ -331,6 +333,7 @@ mod tests {
             s: None,
             feed: Some(500.0),
             rapid: k == 0,
+            reorient: k == 0,
             line: k + 2,
         };
         let rows = [row(0.0, 20.0, 0), row(10.0, 20.0, 1), row(10.0, 22.0, 2), row(20.0, 22.0, 3)];
@@ -360,6 +363,7 @@ mod tests {
                     s: None,
                     feed: Some(500.0),
                     rapid: k == 0,
+                    reorient: k == 0,
                     line: (pass * 73 + k) as u64 + 2,
                 });
             }

@@ -1,8 +1,11 @@
 //! `post-6axis`: CL rows to NC for a machine described in JSON, checked by reading the NC back.
 
 use camkit::cli::{self, IoArgs, positive};
+use camkit::collide::walls::Walls;
 use camkit::doc::Frame;
+use camkit::doc::Setup;
 use camkit::doc::machine::Machine;
+use camkit::doc::setup::{Job, Part};
 use camkit::error::{Error, Location, Result};
 use camkit::gcode::read_axes;
 use camkit::io::{Input, Output};
@@ -10,7 +13,7 @@ use camkit::kinematics::Chain;
 use camkit::report::Report;
 use camkit::table::{self, Col, WriteOptions};
 use clap::Parser;
-use post_6axis::{Settings, cl_rows, post, readback};
+use post_6axis::{Settings, cl_rows, collision, link, post, readback};
 use std::process::ExitCode;
 use std::time::Instant;
 
@@ -61,6 +64,20 @@ struct Args {
     /// INPUT is an NC program: write it back as the toolpath table.
     #[arg(long)]
     reverse: bool,
+    /// The job's setup document (JSON: stock, part, heights, plunge, tool): the passes are linked
+    /// (retract, traverse, approach, plunge), the header takes the tool's number, spindle speed
+    /// and feeds, and the written program is checked for collisions before it is delivered.
+    #[arg(long, value_name = "FILE")]
+    setup: Option<String>,
+    /// Check the program FILE (any NC this machine's reader reads) for collisions against
+    /// --setup, as the post checks its own: the report (JSON) on standard output, exit 1 naming
+    /// the first block that comes too near the material or the part. INPUT is not read.
+    #[arg(long, value_name = "NC", requires = "setup", conflicts_with_all = ["verify", "reverse"])]
+    check: Option<String>,
+    /// Write the program even when the collision check finds a rapid into material or a move
+    /// nearer the part than allowed (a warning; the report names them).
+    #[arg(long, requires = "setup")]
+    allow_collision: bool,
 }
 
 fn after_help() -> String {
@@ -89,23 +106,55 @@ fn load_machine(args: &Args) -> Result<(Machine, Chain)> {
     Ok((machine, chain))
 }
 
+/// The machine's program header made to the job: the tool's number (required), spindle speed
+/// and the setup's coolant.
+fn with_job(mut machine: Machine, job: &Job) -> Result<Machine> {
+    let Some(number) = job.tool.number else {
+        return Err(Error::input("the tool has no `number`: the program needs it for T and H")
+            .at(Location::file(&job.tool_file).field("number")));
+    };
+    machine.program.tool = Some(number);
+    machine.program.spindle_speed = job.tool.spindle_speed;
+    machine.program.coolant = job.coolant;
+    Ok(machine)
+}
+
 fn run(args: Args) -> Result<()> {
     let started = Instant::now();
+    let job = args.setup.as_deref().map(Setup::read).transpose()?;
     let settings = Settings {
         tol: positive(args.tol, "--tol")?,
         angle_tol: positive(args.angle_tol, "--angle-tol")?,
         spindle_tol: positive(args.spindle_tol, "--spindle-tol")?,
         rotary_radius: positive(args.rotary_radius, "--rotary-radius")?,
-        feed: args.feed.map(|f| positive(f, "--feed")).transpose()?,
+        feed: args
+            .feed
+            .map(|f| positive(f, "--feed"))
+            .transpose()?
+            .or(job.as_ref().and_then(|j| j.tool.cutting_feed())),
     };
     let (machine, chain) = load_machine(&args)?;
-    let input = Input::open(&args.io.input)?;
+    let machine = match &job {
+        Some(j) => with_job(machine, j)?,
+        None => machine,
+    };
     let mut out = Output::new(args.io.output.as_deref());
     let mut report = Report::new("post-6axis");
     report
         .set("machine", &machine.name)
         .set("family", chain.family().name())
         .set("dialect", format!("{:?}", machine.dialect).to_lowercase());
+    if let (Some(nc), Some(j)) = (&args.check, &job) {
+        let nc_input = Input::open(nc)?;
+        let text = nc_input.text()?;
+        read_axes(&nc_input.name, text)?;
+        report.set("program", &nc_input.name);
+        let failed = collide(text.as_bytes(), &machine, &chain, j, &args, &mut report);
+        out.buf = report.to_json().into_bytes();
+        finish(out, &args, report)?;
+        return failed;
+    }
+    let input = Input::open(&args.io.input)?;
     if args.reverse {
         let text = input.text()?;
         let program = read_axes(&input.name, text)?;
@@ -143,12 +192,40 @@ fn run(args: Args) -> Result<()> {
         }
         return Ok(());
     }
-    let comments = vec![
+    let mut comments = vec![
         format!("post-6axis {}: {}", env!("CARGO_PKG_VERSION"), machine.name),
         format!("{} machine, {} rows from {}", chain.family().name(), rows.len(), input.name),
         format!("tolerance {} mm, {} deg", settings.tol, settings.angle_tol),
     ];
+    let rows = match &job {
+        Some(j) => {
+            let linked = link::Linker::new(j, &input.name)?.link(&rows)?;
+            comments.push(format!(
+                "setup {}: tool T{} from {}, clearance Z{} safe Z{} approach {} mm",
+                j.file,
+                j.tool.number.unwrap_or(0),
+                j.tool_file,
+                j.clearance_height,
+                j.safe_height,
+                j.approach
+            ));
+            link_keys(&mut report, &linked.stats);
+            linked.rows
+        }
+        None => {
+            let passes = rows.iter().filter(|r| r.rapid).count();
+            if passes > 1 {
+                cli::warn(&format!(
+                    "{passes} passes joined by straight G0 moves as given, not linked or checked against the stock: give --setup"
+                ));
+            }
+            rows
+        }
+    };
     let posted = post(&rows, &input.name, &machine, &chain, &settings, comments)?;
+    if let Some(j) = &job {
+        collide(&posted.text, &machine, &chain, j, &args, &mut report)?;
+    }
     out.buf = posted.text;
     if posted.plan.singular_rows > 0 {
         cli::warn(&format!(
@@ -178,6 +255,68 @@ fn run(args: Args) -> Result<()> {
     deviation_keys(&mut report, &posted.check);
     report.set("seconds", seconds).set("rows_per_second", rows.len() as f64 / seconds.max(1e-9));
     finish(out, &args, report)
+}
+
+fn link_keys(report: &mut Report, s: &link::Stats) {
+    report
+        .set("links", s.links)
+        .set("traverses_at_clearance", s.at_clearance)
+        .set("plunges", s.plunges)
+        .set("plunge_mm", s.plunge_mm)
+        .set("ramps", s.ramps)
+        .set("starts_reached_by_rapid", s.direct);
+}
+
+/// Runs the collision check on the written program; a program that fails it is not delivered
+/// (exit 1) unless --allow-collision.
+fn collide(text: &[u8], machine: &Machine, chain: &Chain, job: &Job, args: &Args, report: &mut Report) -> Result<()> {
+    let text = std::str::from_utf8(text).map_err(|_| Error::runtime("the written program is not UTF-8"))?;
+    let program = read_axes("written program", text)?;
+    let reading = readback::Reading::new(machine, chain);
+    let poses = readback::poses(&program, &reading);
+    let reach = job.tool.radius + job.approach.max(5.0);
+    let walls = match &job.part {
+        Some(Part::Walls { regions, floor, top }) => Some(Walls::new(regions, *floor, *top, reach)),
+        _ => None,
+    };
+    let check = collision::Check { job, walls: walls.as_ref() };
+    let o = check.run(&poses, &reading).map_err(Error::runtime)?;
+    let pair = |v: Option<(f64, u32)>| v.map(|(c, _)| c);
+    let line = |v: Option<(f64, u32)>| v.map(|(_, l)| l);
+    report
+        .set("collision_checked", true)
+        .set("material_resolution_mm", job.resolution)
+        .set("rapid_blocks", o.rapid_blocks)
+        .set("retracts", o.retracts)
+        .set("rapids_into_material", o.rapids_into_material)
+        .set("smallest_rapid_clearance_mm", pair(o.rapid_clearance))
+        .set("smallest_rapid_clearance_line", line(o.rapid_clearance))
+        .set("smallest_rapid_part_clearance_mm", pair(o.rapid_part_clearance))
+        .set("feed_blocks", o.feed_blocks)
+        .set("smallest_feed_clearance_mm", pair(o.feed_clearance))
+        .set("smallest_feed_clearance_line", line(o.feed_clearance))
+        .set("part_collisions", o.part_collisions)
+        .set("unchecked_blocks", o.unchecked_blocks)
+        .set("tilted_cuts_not_mapped", o.tilted_cuts)
+        .set("part_checked", if walls.is_some() { "walls" } else { "none" });
+    if let Some((nc_line, what)) = &o.first {
+        let message = format!(
+            "collision check: NC line {nc_line}: {what} ({} rapids into material, {} moves too near the part)",
+            o.rapids_into_material, o.part_collisions
+        );
+        if args.check.is_some() {
+            return Err(Error::check(message));
+        }
+        if args.allow_collision {
+            cli::warn(&format!("{message}; written anyway (--allow-collision)"));
+        } else {
+            if let Some(path) = &args.io.report {
+                report.write(path)?;
+            }
+            return Err(Error::check(format!("{message}: the program is not written (--allow-collision writes it)")));
+        }
+    }
+    Ok(())
 }
 
 fn deviation_keys(report: &mut Report, d: &readback::Deviation) {

@@ -20,6 +20,9 @@ pub struct Cl {
     pub feed: Option<f64>,
     /// The row starts a pass (rapid, or a new `path`): reached by G0.
     pub rapid: bool,
+    /// The rotary axes may turn freely on the way to this row (a G0 at a retract height):
+    /// wrapping axes are unwound here, and nowhere else.
+    pub reorient: bool,
     /// Source line, for messages.
     pub line: u64,
 }
@@ -229,7 +232,7 @@ fn poses(rows: &[Cl], m: &Machine, opts: &Options, stats: &mut Stats) -> Result<
     for (i, row) in rows.iter().enumerate() {
         let mut c =
             m.solver.choose(&row.axis, &prev).map_err(|e| PlanError { row: i, message: e.0, unreachable: true })?;
-        if row.rapid {
+        if row.reorient {
             for (k, r) in chain.rotaries().iter().enumerate() {
                 if r.wrap && c.rot[k].abs() >= 360.0 {
                     c.rot[k] = principal_deg(c.rot[k]);
@@ -390,7 +393,7 @@ fn inserted(m: &Machine, opts: &Options, a: &Step, b: &Step, t: f64) -> Result<S
         (Some(x), Some(y)) => Some(x + principal_deg(y - x) * t),
         _ => b.cl.s,
     };
-    let cl = Cl { tip, axis, s, feed: b.cl.feed, rapid: false, line: b.cl.line };
+    let cl = Cl { tip, axis, s, feed: b.cl.feed, rapid: false, reorient: false, line: b.cl.line };
     let chain = m.chain();
     let singular = a.singular || b.singular;
     let c = if singular && chain.rotaries().len() == 2 {

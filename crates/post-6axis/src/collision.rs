@@ -1,0 +1,229 @@
+//! The collision check of a written program, before it is delivered: every block read back
+//! through the forward kinematics and followed in the workpiece frame, in program order.
+//!
+//! - Rapids against the material: the stock less what the program's feed moves have cut so far
+//!   (the material map, [`camkit::collide::material`]). Every rapid keeps the setup's approach
+//!   distance above the material under the tool's footprint and its holder's, except a retract:
+//!   a rapid straight up the tool axis moves the body into the column it stands in, which its
+//!   own cut has emptied (checked against the part only).
+//! - Rapids and feeds against the part: a 2.5-D part's walls and floor exactly
+//!   ([`camkit::collide::walls`]); every move keeps the promised clearance (the allowance) less
+//!   the setup's tolerance.
+//!
+//! Blocks whose start is unknown (the first move after the tool change, a move after a G53 block)
+//! cannot be followed: they are counted, not checked.
+
+use crate::readback::{NcPose, Reading};
+use camkit::collide::material::{Cutter, Material};
+use camkit::collide::walls::{Column, Walls};
+use camkit::contour::Seg;
+use camkit::doc::Job;
+use camkit::geom::{P2, P3, V3};
+
+/// How the program measured.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Outcome {
+    /// Rapid blocks checked.
+    pub rapid_blocks: usize,
+    /// Feed blocks checked.
+    pub feed_blocks: usize,
+    /// Blocks whose start is unknown.
+    pub unchecked_blocks: usize,
+    /// Smallest height of a rapid (not a retract) above the material (mm), and its NC line.
+    pub rapid_clearance: Option<(f64, u32)>,
+    /// Rapids straight up the tool axis (retracts).
+    pub retracts: usize,
+    /// Smallest clearance of a rapid from the part (mm), and its NC line.
+    pub rapid_part_clearance: Option<(f64, u32)>,
+    /// Smallest clearance of a feed move from the part (mm), and its NC line.
+    pub feed_clearance: Option<(f64, u32)>,
+    /// Rapid blocks that come nearer the material than they may.
+    pub rapids_into_material: usize,
+    /// Blocks (rapid or feed) that come nearer the part than the allowance less the tolerance.
+    pub part_collisions: usize,
+    /// Feed moves with a tilted tool axis, not taken off the material map (it stays higher).
+    pub tilted_cuts: usize,
+    /// The first violation: NC line and what happened.
+    pub first: Option<(u32, String)>,
+}
+
+impl Outcome {
+    /// True if nothing came too near.
+    pub fn clean(&self) -> bool {
+        self.first.is_none()
+    }
+}
+
+fn least(slot: &mut Option<(f64, u32)>, v: f64, line: u32) {
+    if slot.is_none_or(|(b, _)| v < b) {
+        *slot = Some((v, line));
+    }
+}
+
+/// A straight stretch of a block in the workpiece frame.
+struct Piece {
+    a: P3,
+    b: P3,
+    axis: V3,
+}
+
+/// The straight stretches of the controller's move from `a` to `b`: one when the rotary axes
+/// stand still (the linear axes then move the tip on a straight line), else samples of the joint
+/// interpolation spaced so that the tip moves at most `step` and the axis 0.5° between them.
+fn pieces(r: &Reading, a: &NcPose, b: &NcPose, step: f64) -> Vec<Piece> {
+    let (ta, xa) = r.at(&a.joints);
+    let tb = r.at(&b.joints).0;
+    if a.joints.rot == b.joints.rot {
+        return vec![Piece { a: ta, b: tb, axis: xa }];
+    }
+    let turn = (0..2).map(|k| (b.joints.rot[k] - a.joints.rot[k]).abs()).fold(0.0, f64::max);
+    // The tip's path can bulge beyond its chord: bound the steps by the chord and the turn.
+    let n = (((tb - ta).norm() / step).max(turn / 0.5).ceil() as usize).clamp(1, 100_000);
+    let mut out = Vec::with_capacity(n);
+    let mut prev = (ta, xa);
+    for k in 1..=n {
+        let t = k as f64 / n as f64;
+        let q = camkit::kinematics::Joints {
+            xyz: a.joints.xyz + (b.joints.xyz - a.joints.xyz) * t,
+            rot: [
+                a.joints.rot[0] + (b.joints.rot[0] - a.joints.rot[0]) * t,
+                a.joints.rot[1] + (b.joints.rot[1] - a.joints.rot[1]) * t,
+            ],
+        };
+        let now = r.at(&q);
+        // The lower of the two axes' dips stands for the piece.
+        let axis = if now.1.z < prev.1.z { now.1 } else { prev.1 };
+        out.push(Piece { a: prev.0, b: now.0, axis });
+        prev = now;
+    }
+    out
+}
+
+/// True if the piece runs up its tool axis (to the rounding of the written words).
+fn along_axis(p: &Piece) -> bool {
+    let d = p.b - p.a;
+    let up = d.dot(&p.axis);
+    up > 0.0 && (d - p.axis * up).norm() <= ROUNDING
+}
+
+/// How far a written position may be from the one planned (mm): the rounding of 4 decimals in
+/// three axes, with a margin.
+const ROUNDING: f64 = 2e-4;
+
+/// What the check compares the moves with.
+pub struct Check<'a> {
+    /// The job.
+    pub job: &'a Job,
+    /// The part's walls, if the part is given by contours.
+    pub walls: Option<&'a Walls>,
+}
+
+fn xy(p: &P3) -> P2 {
+    P2::new(p.x, p.y)
+}
+
+impl Check<'_> {
+    /// Follows the program's blocks and measures every one.
+    pub fn run(&self, poses: &[Option<NcPose>], reading: &Reading) -> Result<Outcome, String> {
+        let job = self.job;
+        let tool = &job.tool;
+        let cutter = Cutter::of(tool);
+        let mut map = Material::new(&job.stock, job.resolution, crate::link::MAX_NODES)
+            .map_err(|n| format!("the material map would have {n} nodes"))?;
+        let length = tool.length.unwrap_or(6.0 * tool.radius);
+        let column = Column { radius: tool.radius, length, holder_radius: 0.5 * tool.holder_diameter.unwrap_or(0.0) };
+        let tol = job.tolerance;
+        let mut o = Outcome::default();
+        let mut prev: Option<&NcPose> = None;
+        for pose in poses {
+            let Some(b) = pose else {
+                prev = None;
+                continue;
+            };
+            let Some(a) = prev else {
+                o.unchecked_blocks += 1;
+                prev = Some(b);
+                continue;
+            };
+            prev = Some(b);
+            let rapid = b.rapid;
+            if rapid {
+                o.rapid_blocks += 1;
+            } else {
+                o.feed_blocks += 1;
+            }
+            let mut into_material = false;
+            let mut into_part = false;
+            for p in pieces(reading, a, b, 0.5 * job.resolution) {
+                let seg = Seg::Line(xy(&p.a), xy(&p.b));
+                let vertical = (p.axis - V3::z()).norm() <= crate::link::VERTICAL;
+                let sin = (1.0 - p.axis.z * p.axis.z).max(0.0).sqrt();
+                let dip = -(cutter.radius - cutter.corner) * sin - cutter.corner * (1.0 - p.axis.z);
+                if rapid && along_axis(&p) {
+                    o.retracts += 1;
+                } else if rapid {
+                    let reach = if vertical {
+                        cutter.radius - tol
+                    } else {
+                        let height = job.stock.top() + job.approach - (p.a.z.min(p.b.z) + dip);
+                        cutter.radius + height.max(0.0) * sin / p.axis.z.max(1e-9)
+                    };
+                    let mut c = map.clearance(&seg, p.a.z + dip, p.b.z + dip, reach.max(0.0)).map(|c| c.0);
+                    if let (Some(d), Some(l)) = (tool.holder_diameter, tool.length) {
+                        let h = map.clearance(&seg, p.a.z + l * p.axis.z, p.b.z + l * p.axis.z, 0.5 * d).map(|c| c.0);
+                        c = match (c, h) {
+                            (Some(x), Some(y)) => Some(x.min(y)),
+                            (x, y) => x.or(y),
+                        };
+                    }
+                    if let Some(c) = c {
+                        least(&mut o.rapid_clearance, c, b.line);
+                        if c < job.approach - tol - 1e-9 && !into_material {
+                            into_material = true;
+                            o.rapids_into_material += 1;
+                            if o.first.is_none() {
+                                let what = if c < 0.0 {
+                                    format!("comes {:.4} mm into material the program has not cut", -c)
+                                } else {
+                                    format!(
+                                        "passes {c:.4} mm above material, within the approach distance {}",
+                                        job.approach
+                                    )
+                                };
+                                o.first = Some((b.line, format!("a rapid (G0) {what}")));
+                            }
+                        }
+                    }
+                }
+                if let Some(w) = self.walls
+                    && vertical
+                {
+                    let c = w.clearance(&column, &seg, p.a.z, p.b.z).mm;
+                    least(if rapid { &mut o.rapid_part_clearance } else { &mut o.feed_clearance }, c, b.line);
+                    if c < job.allowance - tol - 1e-9 && !into_part {
+                        into_part = true;
+                        o.part_collisions += 1;
+                        if o.first.is_none() {
+                            let kind = if rapid { "a rapid (G0)" } else { "a feed move" };
+                            o.first = Some((
+                                b.line,
+                                format!(
+                                    "{kind} comes {c:.4} mm from the part's walls or floor, less than the allowance {} mm (tolerance {tol} mm)",
+                                    job.allowance
+                                ),
+                            ));
+                        }
+                    }
+                }
+                if !rapid {
+                    if vertical {
+                        map.cut(&cutter, &seg, p.a.z, p.b.z);
+                    } else {
+                        o.tilted_cuts += 1;
+                    }
+                }
+            }
+        }
+        Ok(o)
+    }
+}

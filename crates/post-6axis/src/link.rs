@@ -1,0 +1,497 @@
+//! Linking: the moves between passes that a job's setup asks for. Every pass start (a `rapid`
+//! row, a new `path`, the program start) becomes: retract along the tool axis to the safe height
+//! (or the clearance height where a traverse at the safe height would come within the approach
+//! distance of material), a rapid traverse at that height (multi-axis re-orientation happens
+//! here), a rapid down the tool axis to the approach distance above the material under the tool,
+//! and a plunge (or a ramp along the pass) at the plunge feed to the pass start. The program ends
+//! with a retract to the clearance height.
+//!
+//! "The material under the tool" is the stock less what the program has cut so far, tracked on
+//! the material map ([`camkit::collide::material`]) as the rows are linked; the collision check
+//! later measures the written program again, independently.
+
+use crate::plan::Cl;
+use camkit::collide::material::{Cutter, Material};
+use camkit::contour::Seg;
+use camkit::doc::Job;
+use camkit::error::{Error, Location, Result};
+use camkit::geom::{P2, P3, V3};
+
+/// The most nodes the material map may have (about 160 MB).
+pub const MAX_NODES: usize = 20_000_000;
+
+/// A tool axis tilted less than this from +Z (radians) counts as vertical: the material map
+/// follows its cuts exactly; a tilted tool's cuts are not taken off the map (it stays higher,
+/// the safe side).
+pub const VERTICAL: f64 = 1e-6;
+
+/// The shortest stretch a ramp runs along (mm).
+pub const RAMP_LEAST: f64 = 0.01;
+
+/// The most rows of a pass a ramp runs along.
+pub const RAMP_ROWS: usize = 10_000;
+
+/// The smallest Z component of a tool axis the post retracts and approaches along.
+pub const LEAST_AXIS_Z: f64 = 0.1;
+
+/// What linking did.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Stats {
+    /// Links made (pass starts, the program start included).
+    pub links: usize,
+    /// Traverses raised to the clearance height because the safe height was not clear.
+    pub at_clearance: usize,
+    /// Plunges (feed moves into material down the tool axis).
+    pub plunges: usize,
+    /// Their total length (mm).
+    pub plunge_mm: f64,
+    /// Ramps made instead of plunges.
+    pub ramps: usize,
+    /// Pass starts reached by rapid alone (already above the material by the approach).
+    pub direct: usize,
+}
+
+/// The linked rows.
+#[derive(Clone, Debug)]
+pub struct Linked {
+    /// Rows with the links in place.
+    pub rows: Vec<Cl>,
+    /// Figures.
+    pub stats: Stats,
+}
+
+/// Everything linking needs besides the rows.
+pub struct Linker<'a> {
+    job: &'a Job,
+    cutter: Cutter,
+    map: Material,
+    file: &'a str,
+    stats: Stats,
+    out: Vec<Cl>,
+}
+
+fn xy(p: &P3) -> P2 {
+    P2::new(p.x, p.y)
+}
+
+fn vertical(axis: &V3) -> bool {
+    (axis - V3::z()).norm() <= VERTICAL
+}
+
+impl<'a> Linker<'a> {
+    /// A linker for `job`; `file` names the rows in messages.
+    pub fn new(job: &'a Job, file: &'a str) -> Result<Linker<'a>> {
+        let map = Material::new(&job.stock, job.resolution, MAX_NODES).map_err(|n| {
+            job.error(
+                "resolution",
+                format!(
+                    "the material map at {} mm would have {n} nodes (at most {MAX_NODES}): raise the resolution",
+                    job.resolution
+                ),
+            )
+        })?;
+        Ok(Linker { job, cutter: Cutter::of(&job.tool), map, file, stats: Stats::default(), out: Vec::new() })
+    }
+
+    fn at(&self, row: &Cl) -> Location {
+        Location::file(self.file).line(row.line)
+    }
+
+    /// The lowest point of the tool body at `row`, relative to its tip (≤ 0): a tilted flat
+    /// bottom dips by R·sin(tilt).
+    fn dip(&self, axis: &V3) -> f64 {
+        let sin = (1.0 - axis.z * axis.z).max(0.0).sqrt();
+        -(self.cutter.radius - self.cutter.corner) * sin - self.cutter.corner * (1.0 - axis.z)
+    }
+
+    /// Radius round the tip's XY that holds the tool body up to `height` above its lowest point.
+    fn reach(&self, axis: &V3, height: f64) -> f64 {
+        let tan = (1.0 - axis.z * axis.z).max(0.0).sqrt() / axis.z;
+        self.cutter.radius + height.max(0.0) * tan
+    }
+
+    /// Highest material under the tool at `row`'s XY (−∞ if none); a footprint that touches the
+    /// side of a cut (within the setup's tolerance) does not count the material beyond it.
+    fn material_under(&self, tip: &P3, axis: &V3) -> f64 {
+        let r = (self.reach(axis, 0.0) - self.job.tolerance).max(0.0);
+        let mut top = self.map.highest_within(&xy(tip), r);
+        if !vertical(axis) {
+            // A tilted body reaches further at the height of the material: widen until stable.
+            for _ in 0..3 {
+                let low = tip.z + self.dip(axis);
+                let r = self.reach(axis, top + self.job.approach - low) - self.job.tolerance;
+                top = self.map.highest_within(&xy(tip), r.max(0.0));
+            }
+        }
+        top
+    }
+
+    /// The point up the axis from `tip` whose body clears `top` by the approach distance (the tip
+    /// itself if it already does).
+    fn approach_point(&self, tip: &P3, axis: &V3, top: f64) -> P3 {
+        let need = top + self.job.approach - (tip.z + self.dip(axis));
+        if need <= 0.0 { *tip } else { tip + axis * (need / axis.z) }
+    }
+
+    /// The point up the axis from `tip` at height `h` (the tip if it is higher).
+    fn up_to(tip: &P3, axis: &V3, h: f64) -> P3 {
+        if tip.z >= h { *tip } else { tip + axis * ((h - tip.z) / axis.z) }
+    }
+
+    /// True if a straight traverse between `a` and `b` keeps the body the approach distance
+    /// above the material (by the map) with its footprint and its holder's.
+    fn clear_traverse(&self, a: &P3, b: &P3, axis_a: &V3, axis_b: &V3) -> bool {
+        let piece = Seg::Line(xy(a), xy(b));
+        let dip = self.dip(axis_a).min(self.dip(axis_b));
+        let tilt = axis_a.z.min(axis_b.z);
+        let tilted = V3::new((1.0 - tilt * tilt).max(0.0).sqrt(), 0.0, tilt);
+        let top = self.job.stock.top();
+        let r = self.reach(&tilted, top + self.job.approach - (a.z.min(b.z) + dip));
+        let body = self.map.clearance(&piece, a.z + dip, b.z + dip, r);
+        let ok = |c: Option<(f64, P2)>| c.is_none_or(|(c, _)| c >= self.job.approach - 1e-9);
+        let holder = match (self.job.tool.holder_diameter, self.job.tool.length) {
+            (Some(d), Some(l)) => self.map.clearance(&piece, a.z + l * tilt, b.z + l * tilt, 0.5 * d),
+            _ => None,
+        };
+        ok(body) && ok(holder)
+    }
+
+    fn row(&self, tip: P3, from: &Cl, rapid: bool, feed: Option<f64>) -> Cl {
+        Cl { tip, axis: from.axis, s: from.s, feed, rapid, reorient: false, line: from.line }
+    }
+
+    /// The zigzag ramp down to `start` along the first stretch of its pass (`rest`: the rows after
+    /// it), for a vertical tool on a level pass: legs to and fro along the pass's own path, the
+    /// stretch as long as two legs at the setup's ramp angle need from the material under the
+    /// start (shorter where the pass stops being level; at most [`RAMP_ROWS`] rows), descending
+    /// from the approach distance above the material under the stretch. `None` where there is
+    /// no such stretch or nothing to descend.
+    fn ramp(&self, start: &Cl, rest: &[Cl]) -> Option<(P3, Vec<P3>)> {
+        let angle = self.job.ramp_angle?;
+        if !vertical(&start.axis) {
+            return None;
+        }
+        let r = (self.cutter.radius - self.job.tolerance).max(0.0);
+        // The stretch two legs at the angle need from the material under the start.
+        let want = (self.map.highest_within(&xy(&start.tip), r) + self.job.approach - start.tip.z)
+            / (2.0 * angle.to_radians().tan());
+        let mut path = vec![start.tip];
+        let mut length = 0.0;
+        let mut top = self.map.highest_within(&xy(&start.tip), r);
+        for row in rest.iter().take(RAMP_ROWS).take_while(|n| !n.rapid && vertical(&n.axis)) {
+            if (row.tip.z - start.tip.z).abs() > 1e-9 || length >= want {
+                break;
+            }
+            let last = path[path.len() - 1];
+            top = top.max(self.map.highest_along(&Seg::Line(xy(&last), xy(&row.tip)), r));
+            length += (row.tip - last).norm();
+            path.push(row.tip);
+        }
+        let top = top + self.job.approach;
+        let drop = top - start.tip.z;
+        if length < RAMP_LEAST || drop <= 0.0 {
+            return None;
+        }
+        let run = drop / angle.to_radians().tan();
+        // An even number of legs, so that the ramp ends where the pass starts.
+        let legs = ((run / length).ceil() as usize).max(1).div_ceil(2) * 2;
+        let leg = run / legs as f64;
+        // The stretch cut at length `leg`: its points from the start.
+        let mut out_leg = vec![];
+        let mut done = 0.0;
+        for w in path.windows(2) {
+            let l = (w[1] - w[0]).norm();
+            if done + l >= leg {
+                out_leg.push(w[0] + (w[1] - w[0]) * ((leg - done) / l));
+                break;
+            }
+            done += l;
+            out_leg.push(w[1]);
+        }
+        let mut flat = out_leg.clone();
+        flat.extend(out_leg.iter().rev().skip(1).copied().chain(std::iter::once(start.tip)));
+        // Heights by distance run: `drop` over `legs` legs.
+        let mut points = Vec::with_capacity(flat.len() * legs / 2);
+        let mut prev = start.tip;
+        let mut ran = 0.0;
+        for _ in 0..legs / 2 {
+            for p in &flat {
+                ran += (p - prev).norm();
+                prev = *p;
+                points.push(P3::new(p.x, p.y, top - drop * (ran / run).min(1.0)));
+            }
+        }
+        if let Some(last) = points.last_mut() {
+            last.z = start.tip.z;
+        }
+        Some((P3::new(start.tip.x, start.tip.y, top), points))
+    }
+
+    /// Appends the link from the last row written (or the program start) to the pass that starts
+    /// with `start` (`next`: the row after it).
+    fn link_to(&mut self, start: &Cl, rest: &[Cl]) -> Result<()> {
+        self.stats.links += 1;
+        if start.axis.z < LEAST_AXIS_Z {
+            return Err(Error::input(format!(
+                "the pass starts with the tool axis {:.1}° from vertical: it cannot be approached along its axis from above",
+                start.axis.z.acos().to_degrees()
+            ))
+            .at(self.at(start).field("i,j,k")));
+        }
+        let ramp = self.ramp(start, rest);
+        let approach = match &ramp {
+            Some((top, _)) => *top,
+            None => self.approach_point(&start.tip, &start.axis, self.material_under(&start.tip, &start.axis)),
+        };
+        let prev = self.out.last().copied();
+        let (safe, clear) = (self.job.safe_height, self.job.clearance_height);
+        let mut height = safe;
+        if let Some(end) = &prev {
+            let (a, b) = (Self::up_to(&end.tip, &end.axis, safe), Self::up_to(&approach, &start.axis, safe));
+            if !self.clear_traverse(&a, &b, &end.axis, &start.axis) {
+                height = clear;
+                self.stats.at_clearance += 1;
+            }
+        } else {
+            height = clear;
+        }
+        if let Some(end) = &prev {
+            if end.axis.z < LEAST_AXIS_Z {
+                return Err(Error::input(format!(
+                    "the pass ends with the tool axis {:.1}° from vertical: it cannot retract along its axis",
+                    end.axis.z.acos().to_degrees()
+                ))
+                .at(self.at(end).field("i,j,k")));
+            }
+            let up = Self::up_to(&end.tip, &end.axis, height);
+            if up != end.tip {
+                self.out.push(self.row(up, end, true, None));
+            }
+        }
+        let above = Self::up_to(&approach, &start.axis, height);
+        let mut traverse = self.row(above, start, true, None);
+        traverse.reorient = true;
+        self.out.push(traverse);
+        if approach != above {
+            self.out.push(self.row(approach, start, true, None));
+        }
+        if approach == start.tip {
+            self.stats.direct += 1;
+            return Ok(());
+        }
+        let feed = Some(self.job.plunge_feed);
+        let points = match ramp {
+            Some((_, points)) => {
+                self.stats.ramps += 1;
+                points
+            }
+            None => {
+                self.stats.plunges += 1;
+                self.stats.plunge_mm += (approach - start.tip).norm();
+                vec![start.tip]
+            }
+        };
+        for p in points {
+            let row = self.row(p, start, false, feed);
+            self.feed(&row);
+        }
+        Ok(())
+    }
+
+    /// Appends a feed row, taking its cut off the map.
+    fn feed(&mut self, row: &Cl) {
+        if let Some(prev) = self.out.last()
+            && vertical(&row.axis)
+            && vertical(&prev.axis)
+        {
+            self.map.cut(&self.cutter, &Seg::Line(xy(&prev.tip), xy(&row.tip)), prev.tip.z, row.tip.z);
+        }
+        self.out.push(Cl { rapid: false, reorient: false, ..*row });
+    }
+
+    /// Refuses rows that cut outside the stock: below its bottom, or beyond its outline by more
+    /// than the tool radius.
+    fn inside(&self, rows: &[Cl]) -> Result<()> {
+        let (lo, hi) = self.job.stock.extent();
+        let r = self.cutter.radius;
+        for row in rows.iter().filter(|row| !row.rapid) {
+            let p = row.tip;
+            let outside = p.x < lo[0] - r || p.x > hi[0] + r || p.y < lo[1] - r || p.y > hi[1] + r;
+            if outside || p.z < self.job.stock.bottom() {
+                return Err(self.job.error(
+                    "stock",
+                    format!(
+                        "the stock does not contain the toolpath: {}:{} cuts at ({:.4}, {:.4}, {:.4}), {} the stock (x {}..{}, y {}..{}, z {}..{})",
+                        self.file,
+                        row.line,
+                        p.x,
+                        p.y,
+                        p.z,
+                        if outside { "outside" } else { "below" },
+                        lo[0],
+                        hi[0],
+                        lo[1],
+                        hi[1],
+                        self.job.stock.bottom(),
+                        self.job.stock.top()
+                    ),
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// Links all `rows` (pass starts are the rows marked `rapid`).
+    pub fn link(mut self, rows: &[Cl]) -> Result<Linked> {
+        self.inside(rows)?;
+        for (i, row) in rows.iter().enumerate() {
+            if row.rapid || self.out.is_empty() {
+                self.link_to(row, &rows[i + 1..])?;
+            } else {
+                self.feed(row);
+            }
+        }
+        if let Some(end) = self.out.last().copied() {
+            let up = Self::up_to(&end.tip, &end.axis, self.job.clearance_height);
+            if up != end.tip {
+                self.out.push(self.row(up, &end, true, None));
+            }
+        }
+        Ok(Linked { rows: self.out, stats: self.stats })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use camkit::doc::setup::{Job, Lead, Stock};
+    use camkit::doc::tool::Tool;
+
+    fn tool() -> Tool {
+        let text = r#"{"kind": "flat", "radius": 4, "number": 1, "plunge_feed": 200}"#;
+        camkit::json::from_input(&camkit::io::Input { name: "t.json".into(), data: text.as_bytes().to_vec() }).unwrap()
+    }
+
+    fn job(stock_top: f64, safe: f64, ramp: Option<f64>) -> Job {
+        Job {
+            file: "s.json".into(),
+            tool: tool(),
+            tool_file: "t.json".into(),
+            stock: Stock::Box { min: P3::new(0.0, 0.0, -30.0), max: P3::new(100.0, 60.0, stock_top) },
+            part: None,
+            part_top: 0.0,
+            clearance_height: 30.0,
+            safe_height: safe,
+            approach: 1.0,
+            plunge_feed: 200.0,
+            ramp_angle: ramp,
+            lead: None::<Lead>,
+            allowance: 0.0,
+            tolerance: 0.01,
+            coolant: Default::default(),
+            resolution: 0.5,
+        }
+    }
+
+    fn cl(x: f64, y: f64, z: f64, rapid: bool) -> Cl {
+        Cl { tip: P3::new(x, y, z), axis: V3::z(), s: None, feed: Some(800.0), rapid, reorient: rapid, line: 2 }
+    }
+
+    /// Two slots at −5: the first reached from the clearance height, the second by a retract to
+    /// the safe height, a traverse, a rapid down to 1 mm above the stock and a plunge at 200.
+    #[test]
+    fn two_passes_are_linked_through_the_safe_height() {
+        let j = job(0.0, 5.0, None);
+        let rows = [
+            cl(10.0, 10.0, -5.0, true),
+            cl(90.0, 10.0, -5.0, false),
+            cl(10.0, 50.0, -5.0, true),
+            cl(90.0, 50.0, -5.0, false),
+        ];
+        let l = Linker::new(&j, "t.csv").unwrap().link(&rows).unwrap();
+        let got: Vec<(f64, f64, f64, bool, Option<f64>)> =
+            l.rows.iter().map(|r| (r.tip.x, r.tip.y, r.tip.z, r.rapid, if r.rapid { None } else { r.feed })).collect();
+        let want = vec![
+            (10.0, 10.0, 30.0, true, None),
+            (10.0, 10.0, 1.0, true, None),
+            (10.0, 10.0, -5.0, false, Some(200.0)),
+            (90.0, 10.0, -5.0, false, Some(800.0)),
+            (90.0, 10.0, 5.0, true, None),
+            (10.0, 50.0, 5.0, true, None),
+            (10.0, 50.0, 1.0, true, None),
+            (10.0, 50.0, -5.0, false, Some(200.0)),
+            (90.0, 50.0, -5.0, false, Some(800.0)),
+            (90.0, 50.0, 30.0, true, None),
+        ];
+        assert_eq!(got, want);
+        assert_eq!(l.rows.iter().filter(|r| r.reorient).count(), 2, "re-orientation only at the traverses");
+        assert_eq!((l.stats.links, l.stats.plunges, l.stats.plunge_mm, l.stats.at_clearance), (2, 2, 12.0, 0));
+    }
+
+    /// The second pass starts inside the first one's slot: the rapid comes down to 1 mm above its
+    /// floor, not the stock top; a pass over material taller than the safe height is reached at
+    /// the clearance height.
+    #[test]
+    fn approach_follows_the_cut_material_and_tall_stock_raises_the_traverse() {
+        let j = job(0.0, 5.0, None);
+        let rows = [
+            cl(10.0, 10.0, -5.0, true),
+            cl(90.0, 10.0, -5.0, false),
+            cl(50.0, 10.0, -8.0, true),
+            cl(60.0, 10.0, -8.0, false),
+        ];
+        let l = Linker::new(&j, "t.csv").unwrap().link(&rows).unwrap();
+        assert!(l.rows.iter().any(|r| r.rapid && r.tip == P3::new(50.0, 10.0, -4.0)), "{:?}", l.rows);
+        assert_eq!(l.stats.plunge_mm, 6.0 + 4.0);
+        // Stock 8 mm above the part (and the safe height): a traverse along the cut slot stays at
+        // the safe height, one across uncut stock goes over at the clearance height.
+        let mut tall = job(8.0, 5.0, None);
+        tall.part_top = 0.0;
+        let l = Linker::new(&tall, "t.csv").unwrap().link(&rows).unwrap();
+        assert_eq!(l.stats.at_clearance, 0, "{:?}", l.rows);
+        let across = [rows[0], rows[1], cl(50.0, 40.0, -8.0, true), cl(60.0, 40.0, -8.0, false)];
+        let l = Linker::new(&tall, "t.csv").unwrap().link(&across).unwrap();
+        assert_eq!(l.stats.at_clearance, 1);
+        let traverse = l.rows.iter().find(|r| r.reorient && r.tip.x == 50.0).unwrap();
+        assert_eq!(traverse.tip.z, 30.0);
+    }
+
+    /// A ramp descends along the pass at the setup's angle (its legs' slope, to rounding), never
+    /// leaves the pass's path, and ends at the pass start.
+    #[test]
+    fn ramps_descend_at_the_angle_along_the_pass() {
+        let j = job(0.0, 5.0, Some(3.0));
+        let rows = [cl(10.0, 10.0, -5.0, true), cl(20.0, 10.0, -5.0, false), cl(20.0, 30.0, -5.0, false)];
+        let l = Linker::new(&j, "t.csv").unwrap().link(&rows).unwrap();
+        assert_eq!((l.stats.ramps, l.stats.plunges), (1, 0));
+        let start = l.rows.iter().position(|r| !r.rapid).unwrap();
+        let ramp: Vec<&Cl> =
+            l.rows[start - 1..].iter().take_while(|r| r.tip.z > -5.0 || r.tip == P3::new(10.0, 10.0, -5.0)).collect();
+        assert_eq!(ramp[0].tip, P3::new(10.0, 10.0, 1.0));
+        let last = ramp.last().unwrap();
+        assert_eq!(last.tip, P3::new(10.0, 10.0, -5.0));
+        let tan = 3f64.to_radians().tan();
+        for w in ramp.windows(2) {
+            let run = (w[1].tip.xy() - w[0].tip.xy()).norm();
+            let drop = w[0].tip.z - w[1].tip.z;
+            assert!(drop > 0.0 && (drop - run * tan).abs() < 1e-9, "{:?} {:?}", w[0].tip, w[1].tip);
+            assert!(w[1].tip.y == 10.0 || w[1].tip.x == 20.0, "off the pass: {:?}", w[1].tip);
+            assert_eq!(w[1].feed, Some(200.0));
+        }
+    }
+
+    #[test]
+    fn toolpaths_outside_the_stock_are_refused() {
+        let j = job(0.0, 5.0, None);
+        let rows = [cl(10.0, 10.0, -5.0, true), cl(120.0, 10.0, -5.0, false)];
+        let e = Linker::new(&j, "t.csv").unwrap().link(&rows).unwrap_err();
+        assert!(e.to_string().starts_with("s.json (stock): the stock does not contain the toolpath: t.csv:2"), "{e}");
+        let rows = [cl(10.0, 10.0, -5.0, true), cl(20.0, 10.0, -31.0, false)];
+        let e = Linker::new(&j, "t.csv").unwrap().link(&rows).unwrap_err();
+        assert!(e.to_string().contains("below the stock"), "{e}");
+        let mut tilted = cl(10.0, 10.0, -5.0, true);
+        tilted.axis = V3::new(1.0, 0.0, 0.05).normalize();
+        let e = Linker::new(&j, "t.csv").unwrap().link(&[tilted]).unwrap_err();
+        assert!(e.to_string().contains("cannot be approached along its axis"), "{e}");
+    }
+}
