@@ -1,6 +1,7 @@
 # The CAM toolkit: build, test, demo parts, benchmarks.
 #   make demo    every demo part into out/<part>/ (one rule per pipeline stage)
-#   make test    all unit, property and end-to-end tests
+#   make test    all unit, property and end-to-end tests, then every demo part, each of its NC
+#                programs read by LinuxCNC's rs274 (where installed) and its collision report checked
 #   make check   formatting, clippy -D warnings, then the tests
 # Demo parameters are variables: `make demo-sine SINE_TOL=0.001`.
 
@@ -35,6 +36,8 @@ PROPTEST_SEED ?= 20261122
 test:
 	$(CARGO) build --bins
 	PROPTEST_RNG_SEED=$(PROPTEST_SEED) $(CARGO) test --workspace
+	$(MAKE) demo
+	scripts/check-demos.sh $(OUT)
 
 lint:
 	$(CARGO) fmt --all -- --check

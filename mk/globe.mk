@@ -23,6 +23,8 @@ GLOBE_LON0 ?= 138
 GLOBE_DEPTH ?= 0.2
 GLOBE_TOOL_R ?= 0.1
 GLOBE_FEED ?= 300
+# The cutting job: stock round the globe, heights, the φ0.2 flat end mill (data/jobs/README.md).
+GLOBE_SETUP ?= data/jobs/globe.json
 
 .PHONY: demo-globe
 demo-globe: $(GLOBE)/summary.txt $(GLOBE)/plan.ngc $(GLOBE)/globe.ngc
@@ -64,5 +66,5 @@ $(GLOBE)/coastline.csv: $(GLOBE_COAST) $(GLOBE)/frame.json $(RELEASE)/surf-probe
 $(GLOBE)/coastline-offset.csv: $(GLOBE)/coastline.csv $(RELEASE)/offset
 	$(RELEASE)/offset $< --3d --radius $(GLOBE_TOOL_R) --side left --report $(GLOBE)/coastline-offset.json -o $@
 
-$(GLOBE)/globe.ngc: $(GLOBE)/coastline-offset.csv $(GLOBE)/frame.json $(GLOBE_MACHINE) $(RELEASE)/post-6axis
-	$(RELEASE)/post-6axis $< --machine $(GLOBE_MACHINE) --frame $(GLOBE)/frame.json --feed $(GLOBE_FEED) --report $(GLOBE)/globe-post.json -o $@
+$(GLOBE)/globe.ngc $(GLOBE)/globe.json &: $(GLOBE)/coastline-offset.csv $(GLOBE)/frame.json $(GLOBE_MACHINE) $(GLOBE_SETUP) $(RELEASE)/post-6axis
+	$(RELEASE)/post-6axis $< --machine $(GLOBE_MACHINE) --frame $(GLOBE)/frame.json --setup $(GLOBE_SETUP) --feed $(GLOBE_FEED) --report $(GLOBE)/globe.json -o $(GLOBE)/globe.ngc

@@ -4,7 +4,7 @@
 # (against tilt 0-15°), §3.2 (against spindle speed at constant feed); a raster program's
 # z-map. The reconstructed fig. 2 conditions (lean, pass phase) are argued in docs/rough-sim.md.
 DEMOS += roughness
-FILTERS += rough-sim
+FILTERS += rough-sim post-6axis
 ROUGHNESS := $(OUT)/roughness
 ROUGHNESS_TOOL ?= data/rough-sim/ball-r5-z2.json
 ROUGHNESS_PICK ?= 0.5
@@ -16,11 +16,13 @@ ROUGHNESS_SWEEP_STEP ?= 0.004
 ROUGHNESS_FLAT ?= 0.5
 ROUGHNESS_FLAT_SHORT ?= 0.3
 ROUGHNESS_FEED ?= 2000
+ROUGHNESS_MACHINE ?= data/post-6axis/three-axis.json
+ROUGHNESS_SETUP ?= data/jobs/roughness-raster.json
 ROUGHNESS_COND = --pick $(ROUGHNESS_PICK) --lean $(ROUGHNESS_LEAN) --pass-phase $(ROUGHNESS_PHASE)
 
 .PHONY: demo-roughness
 demo-roughness: $(foreach t,0 3 10,$(ROUGHNESS)/fig2-tilt$(t).csv) $(ROUGHNESS)/flat-tip.csv $(ROUGHNESS)/fig7-flat.csv $(ROUGHNESS)/fig7-flat-short.csv \
-  $(ROUGHNESS)/fig4b-feed.csv $(ROUGHNESS)/fig5b-tilt.csv $(ROUGHNESS)/spindle.csv $(ROUGHNESS)/raster-zmap.csv
+  $(ROUGHNESS)/fig4b-feed.csv $(ROUGHNESS)/fig5b-tilt.csv $(ROUGHNESS)/spindle.csv $(ROUGHNESS)/raster-zmap.csv $(ROUGHNESS)/raster.ngc
 
 # Fig. 2 / fig. 5a: one periodic cell (pick feed × feed per tooth), heights, colour map, the
 # profiles through the highest point, the figures (cusp, remainder, Rz/Ra, up- and down-cut).
@@ -70,3 +72,7 @@ $(ROUGHNESS)/raster.csv: mk/roughness.mk | $(ROUGHNESS)/
 $(ROUGHNESS)/raster-zmap.csv $(ROUGHNESS)/raster-zmap.svg $(ROUGHNESS)/raster-zmap.json &: $(ROUGHNESS)/raster.csv $(ROUGHNESS_TOOL) $(RELEASE)/rough-sim
 	$(RELEASE)/rough-sim zmap $< --tool $(ROUGHNESS_TOOL) --spindle 1000 --step 0.01 --area=-0.75,-0.5,0.75,0.5 \
 	  --svg $(ROUGHNESS)/raster-zmap.svg --report $(ROUGHNESS)/raster-zmap.json -o $(ROUGHNESS)/raster-zmap.csv
+
+# The raster as the program a 3-axis machine runs: linked through the safe height, checked.
+$(ROUGHNESS)/raster.ngc $(ROUGHNESS)/raster.json &: $(ROUGHNESS)/raster.csv $(ROUGHNESS_MACHINE) $(ROUGHNESS_SETUP) $(RELEASE)/post-6axis
+	$(RELEASE)/post-6axis $< --machine $(ROUGHNESS_MACHINE) --setup $(ROUGHNESS_SETUP) --report $(ROUGHNESS)/raster.json -o $(ROUGHNESS)/raster.ngc

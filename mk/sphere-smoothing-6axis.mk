@@ -2,7 +2,7 @@
 # trace into tool tip, tool axis and spindle orientation of the φ25 cylindrical non-rotating tool
 # tilted −5° toward the feed (R' = 143 mm by eq. 1), the whole tool body checked against the model;
 # post-6axis writes six-axis NC for paper 000's A/C table machine, the edge orientation as a B
-# address. This file sorts before mk/sphere-smoothing.mk, so it names the directory itself.
+# address, the passes linked through the job's safe height and the program checked for collisions. This file sorts before mk/sphere-smoothing.mk, so it names the directory itself.
 FILTERS += tool-attitude post-6axis
 SPHERE_SMOOTHING_6AXIS := $(OUT)/sphere-smoothing
 SPHERE_SMOOTHING_TOOL ?= data/tool-attitude/cylinder-phi25.json
@@ -11,8 +11,10 @@ SPHERE_SMOOTHING_MACHINE ?= data/post-6axis/paper000-sixaxis-b.json
 SPHERE_SMOOTHING_FEED ?= 1000
 # Read-back tolerance of the NC (mm): the issue asks for the demo parts within 1 µm.
 SPHERE_SMOOTHING_NC_TOL ?= 0.001
+# The job: stock over the cap, heights, the tool by reference (data/jobs/README.md).
+SPHERE_SMOOTHING_SETUP ?= data/jobs/sphere-smoothing.json
 
-demo-sphere-smoothing: $(SPHERE_SMOOTHING_6AXIS)/tool.csv $(SPHERE_SMOOTHING_6AXIS)/part.nc
+demo-sphere-smoothing: $(SPHERE_SMOOTHING_6AXIS)/tool.csv $(SPHERE_SMOOTHING_6AXIS)/part.ngc
 
 $(SPHERE_SMOOTHING_6AXIS)/tool.csv $(SPHERE_SMOOTHING_6AXIS)/tool.json &: $(SPHERE_SMOOTHING_6AXIS)/cl.csv \
   $(SPHERE_SMOOTHING_6AXIS)/model.json $(SPHERE_SMOOTHING_TOOL) $(RELEASE)/tool-attitude
@@ -20,7 +22,7 @@ $(SPHERE_SMOOTHING_6AXIS)/tool.csv $(SPHERE_SMOOTHING_6AXIS)/tool.json &: $(SPHE
 	  --model $(SPHERE_SMOOTHING_6AXIS)/model.json \
 	  --report $(SPHERE_SMOOTHING_6AXIS)/tool.json -o $(SPHERE_SMOOTHING_6AXIS)/tool.csv
 
-$(SPHERE_SMOOTHING_6AXIS)/part.nc $(SPHERE_SMOOTHING_6AXIS)/part.json &: $(SPHERE_SMOOTHING_6AXIS)/tool.csv \
-  $(SPHERE_SMOOTHING_MACHINE) $(RELEASE)/post-6axis
-	$(RELEASE)/post-6axis $< --machine $(SPHERE_SMOOTHING_MACHINE) --feed $(SPHERE_SMOOTHING_FEED) --tol $(SPHERE_SMOOTHING_NC_TOL) \
-	  --report $(SPHERE_SMOOTHING_6AXIS)/part.json -o $(SPHERE_SMOOTHING_6AXIS)/part.nc
+$(SPHERE_SMOOTHING_6AXIS)/part.ngc $(SPHERE_SMOOTHING_6AXIS)/part.json &: $(SPHERE_SMOOTHING_6AXIS)/tool.csv \
+  $(SPHERE_SMOOTHING_MACHINE) $(SPHERE_SMOOTHING_SETUP) $(RELEASE)/post-6axis
+	$(RELEASE)/post-6axis $< --machine $(SPHERE_SMOOTHING_MACHINE) --setup $(SPHERE_SMOOTHING_SETUP) --feed $(SPHERE_SMOOTHING_FEED) --tol $(SPHERE_SMOOTHING_NC_TOL) \
+	  --report $(SPHERE_SMOOTHING_6AXIS)/part.json -o $(SPHERE_SMOOTHING_6AXIS)/part.ngc

@@ -128,6 +128,12 @@ impl Material {
         ys.flat_map(move |j| xs.clone().map(move |i| (j * self.nx + i, self.node(i, j))))
     }
 
+    /// The radius a footprint query covers: at least half a cell's diagonal, so that a footprint
+    /// smaller than the spacing still sees the nodes round it.
+    fn footprint(&self, radius: f64) -> f64 {
+        radius.max(self.step * std::f64::consts::FRAC_1_SQRT_2)
+    }
+
     /// Top of the material at the node nearest `p` (−∞ where there is none).
     pub fn top_near(&self, p: &P2) -> f64 {
         let i = ((p.x - self.origin.x) / self.step).round();
@@ -159,6 +165,7 @@ impl Material {
     /// within `radius` of the piece, the lowest the bottom is while the node is under it, less the
     /// node's top. `None` if no material lies under the footprint. Also returns the node.
     pub fn clearance(&self, piece: &Seg, z0: f64, z1: f64, radius: f64) -> Option<(f64, P2)> {
+        let radius = self.footprint(radius);
         let mut best: Option<(f64, P2)> = None;
         for (k, p) in self.near(piece, radius) {
             let top = self.top[k];
@@ -182,6 +189,7 @@ impl Material {
 
     /// Highest material within `radius` of the XY piece (−∞ if none).
     pub fn highest_along(&self, piece: &Seg, radius: f64) -> f64 {
+        let radius = self.footprint(radius);
         self.near(piece, radius)
             .filter(|(_, q)| piece.distance_to(q) <= radius)
             .map(|(k, _)| self.top[k])
@@ -329,6 +337,9 @@ mod tests {
         let (c, at) = m.clearance(&Seg::Line(P2::new(12.0, 15.0), P2::new(12.0, 25.0)), -2.0, -2.0, 4.0).unwrap();
         assert_eq!(c, -2.0);
         assert_eq!(m.top_near(&at), 0.0, "{at:?}");
+        // A footprint smaller than the spacing sees the nodes round it.
+        assert_eq!(m.highest_within(&P2::new(20.2, 19.7), 0.01), 0.0);
+        assert_eq!(m.highest_within(&P2::new(20.2, 15.2), 0.01), -5.0);
         // Outside the stock there is nothing.
         assert!(m.clearance(&Seg::Line(P2::new(50.0, 15.0), P2::new(60.0, 15.0)), -10.0, -10.0, 4.0).is_none());
     }
