@@ -12,6 +12,7 @@
 
 use crate::plan::Cl;
 use camkit::collide::material::{Cutter, Material};
+use camkit::collide::walls::{Column, Walls};
 use camkit::contour::Seg;
 use camkit::doc::Job;
 use camkit::error::{Error, Location, Result};
@@ -63,6 +64,7 @@ pub struct Linked {
 /// Everything linking needs besides the rows.
 pub struct Linker<'a> {
     job: &'a Job,
+    walls: Option<&'a Walls>,
     cutter: Cutter,
     map: Material,
     file: &'a str,
@@ -79,8 +81,9 @@ fn vertical(axis: &V3) -> bool {
 }
 
 impl<'a> Linker<'a> {
-    /// A linker for `job`; `file` names the rows in messages.
-    pub fn new(job: &'a Job, file: &'a str) -> Result<Linker<'a>> {
+    /// A linker for `job` (with the part's walls, if it has them); `file` names the rows in
+    /// messages.
+    pub fn new(job: &'a Job, walls: Option<&'a Walls>, file: &'a str) -> Result<Linker<'a>> {
         let map = Material::new(&job.stock, job.resolution, MAX_NODES).map_err(|n| {
             job.error(
                 "resolution",
@@ -90,7 +93,7 @@ impl<'a> Linker<'a> {
                 ),
             )
         })?;
-        Ok(Linker { job, cutter: Cutter::of(&job.tool), map, file, stats: Stats::default(), out: Vec::new() })
+        Ok(Linker { job, walls, cutter: Cutter::of(&job.tool), map, file, stats: Stats::default(), out: Vec::new() })
     }
 
     fn at(&self, row: &Cl) -> Location {
@@ -341,9 +344,34 @@ impl<'a> Linker<'a> {
         Ok(())
     }
 
+    /// Refuses a pass that starts inside the part: the post cannot reach it safely.
+    fn reachable(&self, rows: &[Cl]) -> Result<()> {
+        let Some(walls) = self.walls else { return Ok(()) };
+        let column = Column {
+            radius: self.cutter.radius,
+            length: self.job.tool.length.unwrap_or(6.0 * self.cutter.radius),
+            holder_radius: 0.0,
+        };
+        for row in rows.iter().filter(|r| r.rapid && vertical(&r.axis)) {
+            let p = xy(&row.tip);
+            let c = walls.clearance(&column, &Seg::Line(p, p), row.tip.z, row.tip.z).mm;
+            if c < self.job.allowance - self.job.tolerance {
+                return Err(self.job.error(
+                    "part",
+                    format!(
+                        "the pass starting at {}:{} ({:.4}, {:.4}, {:.4}) cannot be reached safely: the tool there comes {c:.4} mm from the part's walls or floor (allowance {} mm)",
+                        self.file, row.line, row.tip.x, row.tip.y, row.tip.z, self.job.allowance
+                    ),
+                ));
+            }
+        }
+        Ok(())
+    }
+
     /// Links all `rows` (pass starts are the rows marked `rapid`).
     pub fn link(mut self, rows: &[Cl]) -> Result<Linked> {
         self.inside(rows)?;
+        self.reachable(rows)?;
         for (i, row) in rows.iter().enumerate() {
             if row.rapid || self.out.is_empty() {
                 self.link_to(row, &rows[i + 1..])?;
@@ -408,7 +436,7 @@ mod tests {
             cl(10.0, 50.0, -5.0, true),
             cl(90.0, 50.0, -5.0, false),
         ];
-        let l = Linker::new(&j, "t.csv").unwrap().link(&rows).unwrap();
+        let l = Linker::new(&j, None, "t.csv").unwrap().link(&rows).unwrap();
         let got: Vec<(f64, f64, f64, bool, Option<f64>)> =
             l.rows.iter().map(|r| (r.tip.x, r.tip.y, r.tip.z, r.rapid, if r.rapid { None } else { r.feed })).collect();
         let want = vec![
@@ -440,17 +468,17 @@ mod tests {
             cl(50.0, 10.0, -8.0, true),
             cl(60.0, 10.0, -8.0, false),
         ];
-        let l = Linker::new(&j, "t.csv").unwrap().link(&rows).unwrap();
+        let l = Linker::new(&j, None, "t.csv").unwrap().link(&rows).unwrap();
         assert!(l.rows.iter().any(|r| r.rapid && r.tip == P3::new(50.0, 10.0, -4.0)), "{:?}", l.rows);
         assert_eq!(l.stats.plunge_mm, 6.0 + 4.0);
         // Stock 8 mm above the part (and the safe height): a traverse along the cut slot stays at
         // the safe height, one across uncut stock goes over at the clearance height.
         let mut tall = job(8.0, 5.0, None);
         tall.part_top = 0.0;
-        let l = Linker::new(&tall, "t.csv").unwrap().link(&rows).unwrap();
+        let l = Linker::new(&tall, None, "t.csv").unwrap().link(&rows).unwrap();
         assert_eq!(l.stats.at_clearance, 0, "{:?}", l.rows);
         let across = [rows[0], rows[1], cl(50.0, 40.0, -8.0, true), cl(60.0, 40.0, -8.0, false)];
-        let l = Linker::new(&tall, "t.csv").unwrap().link(&across).unwrap();
+        let l = Linker::new(&tall, None, "t.csv").unwrap().link(&across).unwrap();
         assert_eq!(l.stats.at_clearance, 1);
         let traverse = l.rows.iter().find(|r| r.reorient && r.tip.x == 50.0).unwrap();
         assert_eq!(traverse.tip.z, 30.0);
@@ -462,7 +490,7 @@ mod tests {
     fn ramps_descend_at_the_angle_along_the_pass() {
         let j = job(0.0, 5.0, Some(3.0));
         let rows = [cl(10.0, 10.0, -5.0, true), cl(20.0, 10.0, -5.0, false), cl(20.0, 30.0, -5.0, false)];
-        let l = Linker::new(&j, "t.csv").unwrap().link(&rows).unwrap();
+        let l = Linker::new(&j, None, "t.csv").unwrap().link(&rows).unwrap();
         assert_eq!((l.stats.ramps, l.stats.plunges), (1, 0));
         let start = l.rows.iter().position(|r| !r.rapid).unwrap();
         let ramp: Vec<&Cl> =
@@ -484,14 +512,14 @@ mod tests {
     fn toolpaths_outside_the_stock_are_refused() {
         let j = job(0.0, 5.0, None);
         let rows = [cl(10.0, 10.0, -5.0, true), cl(120.0, 10.0, -5.0, false)];
-        let e = Linker::new(&j, "t.csv").unwrap().link(&rows).unwrap_err();
+        let e = Linker::new(&j, None, "t.csv").unwrap().link(&rows).unwrap_err();
         assert!(e.to_string().starts_with("s.json (stock): the stock does not contain the toolpath: t.csv:2"), "{e}");
         let rows = [cl(10.0, 10.0, -5.0, true), cl(20.0, 10.0, -31.0, false)];
-        let e = Linker::new(&j, "t.csv").unwrap().link(&rows).unwrap_err();
+        let e = Linker::new(&j, None, "t.csv").unwrap().link(&rows).unwrap_err();
         assert!(e.to_string().contains("below the stock"), "{e}");
         let mut tilted = cl(10.0, 10.0, -5.0, true);
         tilted.axis = V3::new(1.0, 0.0, 0.05).normalize();
-        let e = Linker::new(&j, "t.csv").unwrap().link(&[tilted]).unwrap_err();
+        let e = Linker::new(&j, None, "t.csv").unwrap().link(&[tilted]).unwrap_err();
         assert!(e.to_string().contains("cannot be approached along its axis"), "{e}");
     }
 }

@@ -149,7 +149,8 @@ fn run(args: Args) -> Result<()> {
         let text = nc_input.text()?;
         read_axes(&nc_input.name, text)?;
         report.set("program", &nc_input.name);
-        let failed = collide(text.as_bytes(), &machine, &chain, j, &args, &mut report);
+        let walls = walls_of(j);
+        let failed = collide(text.as_bytes(), &machine, &chain, j, walls.as_ref(), &args, &mut report);
         out.buf = report.to_json().into_bytes();
         finish(out, &args, report)?;
         return failed;
@@ -197,9 +198,10 @@ fn run(args: Args) -> Result<()> {
         format!("{} machine, {} rows from {}", chain.family().name(), rows.len(), input.name),
         format!("tolerance {} mm, {} deg", settings.tol, settings.angle_tol),
     ];
+    let walls = job.as_ref().and_then(walls_of);
     let rows = match &job {
         Some(j) => {
-            let linked = link::Linker::new(j, &input.name)?.link(&rows)?;
+            let linked = link::Linker::new(j, walls.as_ref(), &input.name)?.link(&rows)?;
             comments.push(format!(
                 "setup {}: tool T{} from {}, clearance Z{} safe Z{} approach {} mm",
                 j.file,
@@ -224,7 +226,7 @@ fn run(args: Args) -> Result<()> {
     };
     let posted = post(&rows, &input.name, &machine, &chain, &settings, comments)?;
     if let Some(j) = &job {
-        collide(&posted.text, &machine, &chain, j, &args, &mut report)?;
+        collide(&posted.text, &machine, &chain, j, walls.as_ref(), &args, &mut report)?;
     }
     out.buf = posted.text;
     if posted.plan.singular_rows > 0 {
@@ -269,17 +271,30 @@ fn link_keys(report: &mut Report, s: &link::Stats) {
 
 /// Runs the collision check on the written program; a program that fails it is not delivered
 /// (exit 1) unless --allow-collision.
-fn collide(text: &[u8], machine: &Machine, chain: &Chain, job: &Job, args: &Args, report: &mut Report) -> Result<()> {
+/// The part's walls, when the setup gives the part by contours: distances measured up to the
+/// tool radius plus the larger of the approach and 5 mm.
+fn walls_of(job: &Job) -> Option<Walls> {
+    let reach = job.tool.radius + job.approach.max(5.0);
+    match &job.part {
+        Some(Part::Walls { regions, floor, top }) => Some(Walls::new(regions, *floor, *top, reach)),
+        _ => None,
+    }
+}
+
+fn collide(
+    text: &[u8],
+    machine: &Machine,
+    chain: &Chain,
+    job: &Job,
+    walls: Option<&Walls>,
+    args: &Args,
+    report: &mut Report,
+) -> Result<()> {
     let text = std::str::from_utf8(text).map_err(|_| Error::runtime("the written program is not UTF-8"))?;
     let program = read_axes("written program", text)?;
     let reading = readback::Reading::new(machine, chain);
     let poses = readback::poses(&program, &reading);
-    let reach = job.tool.radius + job.approach.max(5.0);
-    let walls = match &job.part {
-        Some(Part::Walls { regions, floor, top }) => Some(Walls::new(regions, *floor, *top, reach)),
-        _ => None,
-    };
-    let check = collision::Check { job, walls: walls.as_ref() };
+    let check = collision::Check { job, walls };
     let o = check.run(&poses, &reading).map_err(Error::runtime)?;
     let pair = |v: Option<(f64, u32)>| v.map(|(c, _)| c);
     let line = |v: Option<(f64, u32)>| v.map(|(_, l)| l);
