@@ -77,7 +77,7 @@ fn blocks(nc: &str) -> Vec<Block> {
     let mut out = Vec::new();
     for (i, line) in nc.lines().enumerate() {
         let words: Vec<&str> = line.split_whitespace().collect();
-        if words.iter().any(|w| *w == "G53") {
+        if words.contains(&"G53") {
             known = [false; 3];
             continue;
         }
