@@ -276,3 +276,43 @@ fn bad_jobs_are_refused_naming_the_field() {
         assert!(!w.exists("p.ngc"), "{needle}");
     }
 }
+
+/// medial-trochoid's layers from a setup: the stock top down to the part's floor in equal steps of
+/// at most --layer-depth; box-die's from the setup are the demo's (4 of 10 mm from z 50), a
+/// 12 mm limit gives the same 4 layers, and 9 mm gives 5 of 8 mm.
+#[test]
+fn medial_trochoid_takes_its_layers_from_the_setup() {
+    let w = Work::new();
+    w.write("tool.json", r#"{"kind": "flat", "radius": 5, "number": 1, "plunge_feed": 200}"#);
+    let contour = data("medial-trochoid/box-die.csv");
+    let contour = contour.to_string_lossy();
+    w.write(
+        "setup.json",
+        format!(
+            r#"{{"tool": "tool.json", "stock": {{"min": [0, 0, 0], "max": [100, 100, 60]}},
+              "part": {{"contours": "{contour}", "floor": 20}}, "clearance_height": 80, "safe_height": 65}}"#
+        ),
+    );
+    let common = ["--threshold", "40", "--sample", "2", "--program", "offset"];
+    let given = {
+        let mut a = vec![contour.as_ref(), "--radius", "5", "--layers", "4", "--layer-depth", "10"];
+        a.extend(common);
+        w.run("medial-trochoid", &a, b"").ok()
+    };
+    let from_setup = |depth: &str, report: &str| {
+        let mut a = vec![contour.as_ref(), "--setup", "setup.json", "--layer-depth", depth, "--report", report];
+        a.extend(common);
+        w.run("medial-trochoid", &a, b"").ok()
+    };
+    assert_eq!(from_setup("10", "a.json"), given);
+    assert_eq!(from_setup("12", "b.json"), given);
+    from_setup("9", "c.json");
+    let r: serde_json::Value = serde_json::from_str(&w.read("c.json")).unwrap();
+    assert_eq!(
+        (r["layers"].as_u64(), r["layer_depth_mm"].as_f64(), r["first_layer_z"].as_f64()),
+        (Some(5), Some(8.0), Some(52.0))
+    );
+    let mut a = vec![contour.as_ref(), "--setup", "setup.json", "--radius", "4"];
+    a.extend(common);
+    w.run("medial-trochoid", &a, b"").fails(2, "--radius 4 disagrees with the radius 5");
+}

@@ -5,6 +5,8 @@ use camkit::cli::{self, IoArgs, positive};
 use camkit::contour::Seg;
 use camkit::contour::region::Region;
 use camkit::contour::table as contour_table;
+use camkit::doc::Setup;
+use camkit::doc::setup::{Job, Part};
 use camkit::error::{Error, Location, Result};
 use camkit::geom::{P2, P3};
 use camkit::io::{Input, Output, write_atomic};
@@ -43,9 +45,14 @@ programs' machining time.",
 struct Args {
     #[command(flatten)]
     io: IoArgs,
-    /// Tool radius R (mm).
-    #[arg(long, value_name = "MM")]
-    radius: f64,
+    /// Tool radius R (mm); default the radius of the setup's tool.
+    #[arg(long, value_name = "MM", required_unless_present = "setup")]
+    radius: Option<f64>,
+    /// The job's setup document (docs/formats.md#setup): the tool's radius, and the layers from
+    /// the stock top down to the part's floor (`part.floor` of a part given by contours, else the
+    /// contour's z) in equal steps of at most --layer-depth (one layer without it).
+    #[arg(long, value_name = "FILE", conflicts_with = "layers")]
+    setup: Option<String>,
     /// Radial step over between passes (mm); default R(1 − cos threshold), the side cut at the
     /// threshold. After a pass with arcs round the pocket (radius ρ ≥ R/8) the step is at most
     /// the one whose concave side cut acos(1 − s/R − s/ρ + s²/(2ρR)) holds the threshold.
@@ -72,10 +79,11 @@ struct Args {
     /// Engagement sample spacing along the path (mm); every move's end is also sampled.
     #[arg(long, default_value_t = 0.5, value_name = "MM")]
     sample: f64,
-    /// Number of layers (each the same 2D program, one layer depth lower).
-    #[arg(long, default_value_t = 1, value_name = "N")]
-    layers: usize,
-    /// Depth of each layer (mm): layer k is cut at z − k·depth, the contour's z being the first layer's bottom.
+    /// Number of layers (each the same 2D program, one layer depth lower; default 1).
+    #[arg(long, value_name = "N")]
+    layers: Option<usize>,
+    /// Depth of each layer (mm): layer k is cut at z − k·depth, the contour's z being the first
+    /// layer's bottom; with --setup, the most a layer may be.
     #[arg(long, default_value_t = 0.0, value_name = "MM")]
     layer_depth: f64,
     /// Which program to write.
@@ -171,9 +179,37 @@ fn main() -> ExitCode {
     cli::run("medial-trochoid", || run(Args::parse()))
 }
 
+/// The first layer's bottom, the number of layers and their depth: from the stock top down to
+/// the floor (the part's, else `contour_z`) with the setup, from the contour's z otherwise.
+fn layering(job: Option<&Job>, contour_z: f64, layers: Option<usize>, depth: f64) -> Result<(f64, usize, f64)> {
+    let Some(job) = job else { return Ok((contour_z, layers.unwrap_or(1), depth)) };
+    let top = job.stock.top();
+    let floor = match &job.part {
+        Some(Part::Walls { floor, .. }) => *floor,
+        _ => contour_z,
+    };
+    if floor >= top {
+        return Err(job.error("stock", format!("the pocket floor {floor} is not below the stock top {top}")));
+    }
+    let n = if depth > 0.0 { ((top - floor) / depth - 1e-9).ceil().max(1.0) as usize } else { 1 };
+    let step = (top - floor) / n as f64;
+    Ok((top - step, n, step))
+}
+
 fn run(args: Args) -> Result<()> {
     let started = Instant::now();
-    let r = positive(args.radius, "--radius")?;
+    let job = args.setup.as_deref().map(Setup::read).transpose()?;
+    let r = match (args.radius, &job) {
+        (Some(r), Some(j)) if (r - j.tool.radius).abs() > 1e-12 => {
+            return Err(Error::input(format!(
+                "--radius {r} disagrees with the radius {} of the setup's tool {}",
+                j.tool.radius, j.tool_file
+            )));
+        }
+        (Some(r), _) => positive(r, "--radius")?,
+        (None, Some(j)) => j.tool.radius,
+        (None, None) => unreachable!("clap requires --radius without --setup"),
+    };
     let threshold = positive(args.threshold, "--threshold")?;
     if threshold >= 180.0 {
         return Err(Error::input("--threshold must be under 180 degrees"));
@@ -186,7 +222,7 @@ fn run(args: Args) -> Result<()> {
     if !(args.allowance.is_finite() && args.allowance >= 0.0) {
         return Err(Error::input(format!("--allowance must be zero or more, got {}", args.allowance)));
     }
-    if !(args.layer_depth.is_finite() && args.layer_depth >= 0.0) || args.layers == 0 {
+    if !(args.layer_depth.is_finite() && args.layer_depth >= 0.0) || args.layers == Some(0) {
         return Err(Error::input("--layers must be at least 1 and --layer-depth zero or more"));
     }
     if args.decimals.is_some_and(|d| d > 12) {
@@ -266,8 +302,8 @@ fn run(args: Args) -> Result<()> {
         _ => Error::input(e.to_string()).at(Location::file(&name)),
     })?;
     let chosen = if args.program == Which::Trochoid { &plan.trochoidal } else { &plan.offset_only };
-    let z0 = sources[0].z;
-    let out_table = to_table(chosen, z0, args.layers, args.layer_depth);
+    let (z0, layer_count, layer_depth) = layering(job.as_ref(), sources[0].z, args.layers, args.layer_depth)?;
+    let out_table = to_table(chosen, z0, layer_count, layer_depth);
     if !plan.uncleared.is_empty() {
         cli::warn(&format!(
             "{} dangerous stretches of the medial axis are too narrow for the smallest trochoid loop ({:.3} mm, the given {rt} mm shrunk): left to the passes",
@@ -339,7 +375,7 @@ fn run(args: Args) -> Result<()> {
         write_atomic(path, plot::plan_plot(&other_t, &plan, !troch_main).to_svg(1000.0).as_bytes())?;
     }
     if let Some(path) = &args.io.report {
-        let layers = args.layers as f64;
+        let layers = layer_count as f64;
         let (a, b) = (&plan.offset_only, &plan.trochoidal);
         let medial_edges: usize = plan.medial.iter().map(|m| m.edges.len()).sum();
         let mut rep = Report::new("medial-trochoid");
@@ -349,7 +385,9 @@ fn run(args: Args) -> Result<()> {
             .set("threshold_deg", threshold)
             .set("allowance_mm", args.allowance)
             .set("sample_mm", settings.sample)
-            .set("layers", args.layers)
+            .set("layers", layer_count)
+            .set("layer_depth_mm", layer_depth)
+            .set("first_layer_z", z0)
             .set("regions", regions.len())
             .set("islands", regions.iter().map(|g| g.islands.len()).sum::<usize>())
             .set("passes_per_layer", plan.passes.len())
