@@ -316,3 +316,59 @@ fn medial_trochoid_takes_its_layers_from_the_setup() {
     a.extend(common);
     w.run("medial-trochoid", &a, b"").fails(2, "--radius 4 disagrees with the radius 5");
 }
+
+/// Random passes (polylines at random depths, clear of the walls and the island) in the island
+/// pocket, posted with the setup: every program passes the independent rapid check and the
+/// post's own collision check, with and without ramps. 40 seeded cases.
+#[test]
+fn random_pocket_jobs_link_safely() {
+    let m = machine();
+    let mut seed = 0x2545_f491_4f6c_dd1du64;
+    let mut rand = move || {
+        seed ^= seed << 13;
+        seed ^= seed >> 7;
+        seed ^= seed << 17;
+        (seed >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let clear = |a: (f64, f64), b: (f64, f64)| {
+        let from = [a.0, a.1, 0.0];
+        let to = [b.0, b.1, 0.0];
+        seg_dist(ISLAND.0, ISLAND.1, &from, &to) >= ISLAND.2 + R + 0.2
+    };
+    for case in 0..40 {
+        let w = job();
+        if case % 2 == 1 {
+            w.write("setup.json", SETUP.replace(r#""approach": 1"#, r#""approach": 1, "plunge": {"ramp_angle": 5}"#));
+        }
+        let mut s = String::from("path,move,x,y,z\n");
+        let passes = 2 + (rand() * 5.0) as usize;
+        for path in 0..passes {
+            let z = -2.0 * (1.0 + (rand() * 6.0).floor());
+            let mut pts: Vec<(f64, f64)> = Vec::new();
+            while pts.len() < 2 + (rand() * 4.0) as usize {
+                let p = (R + 0.5 + rand() * (100.0 - 2.0 * R - 1.0), R + 0.5 + rand() * (60.0 - 2.0 * R - 1.0));
+                if pts.last().is_none_or(|q| clear(*q, p)) && clear(p, p) {
+                    pts.push(p);
+                }
+            }
+            for (k, (x, y)) in pts.iter().enumerate() {
+                s.push_str(&format!("{path},{},{x:.4},{y:.4},{z}\n", if k == 0 { "rapid" } else { "line" }));
+            }
+        }
+        w.write("passes.csv", &s);
+        let o = w.run(
+            BIN,
+            &["passes.csv", "--machine", &m, "--setup", "setup.json", "--report", "r.json", "-o", "p.ngc"],
+            b"",
+        );
+        assert_eq!(o.status, 0, "case {case}: {}\n{s}", o.stderr);
+        let nc = w.read("p.ngc");
+        assert_eq!(unsafe_rapids(&nc), vec![], "case {case}:\n{s}");
+        let r = report(&w, "r.json");
+        assert_eq!(
+            (r["rapids_into_material"].as_u64(), r["part_collisions"].as_u64()),
+            (Some(0), Some(0)),
+            "case {case}"
+        );
+    }
+}
