@@ -125,22 +125,32 @@ fn paper_002_forward(x: f64, y: f64, z: f64, a: f64, c: f64) -> (P3, V3) {
     (tip, axis)
 }
 
-/// X Y Z A C of every G1/G0 block of a program (modal values carried), by plain text parsing.
+/// X Y Z A C of every G1/G0 block of a program (modal values carried) once every axis has been
+/// given since the last G53 block (which leaves the work position of its axes unknown), by plain
+/// text parsing.
 fn blocks(nc: &str) -> Vec<[f64; 5]> {
     let mut v = [0.0; 5];
+    let mut known = [false; 5];
     let mut out = Vec::new();
     for line in nc.lines() {
         let line = line.split('(').next().unwrap();
         let words: Vec<&str> = line.split_whitespace().collect();
-        if words.contains(&"G53") || !words.iter().any(|w| ["X", "Y", "Z", "A", "C"].iter().any(|l| w.starts_with(l))) {
+        if words.contains(&"G53") {
+            known = [false; 5];
+            continue;
+        }
+        if !words.iter().any(|w| ["X", "Y", "Z", "A", "C"].iter().any(|l| w.starts_with(l))) {
             continue;
         }
         for w in words {
             if let Some(k) = ["X", "Y", "Z", "A", "C"].iter().position(|l| w.starts_with(l)) {
                 v[k] = w[1..].parse().unwrap();
+                known[k] = true;
             }
         }
-        out.push(v);
+        if known.iter().all(|k| *k) {
+            out.push(v);
+        }
     }
     out
 }
@@ -428,7 +438,9 @@ fn bad_input_is_refused_without_output() {
     run("x,y,z,i,j,k,f\n0,0,NaN,0,0,1,100\n").fails(2, "in.csv:2:3 (z): expected a finite number");
     run("x,y,z,i,j,k\n0,0,0,0,0,1\n1,0,0,0,0,1\n").fails(2, "in.csv:3 (f): no feed");
     run("x,y,z,i,j,k,s,f\n0,0,0,0,0,1,10,100\n").fails(2, "no `spindle`");
-    run("x,y,z,i,j,k,f,move,xc,yc\n0,0,0,0,0,1,100,line,,\n1,1,0,0,0,1,100,cw,0,1\n").fails(2, "arcs");
+    run("x,y,z,i,j,k,f,move,xc,yc\n1,1,0,0,0,1,100,cw,0,1\n").fails(2, "in.csv:2 (move): an arc needs a start");
+    run("x,y,z,i,j,k,f,move,xc,yc\n0,0,0,0,0,1,100,line,,\n1,1,0,0,0,1,100,cw,0,2\n")
+        .fails(2, "in.csv:3 (xc,yc): the arc's ends are 2.000000 and 1.414214 mm from its centre");
     run("").fails(2, "empty input");
     assert!(!w.exists("out.nc"));
     // Over the pole and down to latitude 59.6° beyond it, A would pass −30°: the machine must

@@ -60,21 +60,74 @@ fn least(slot: &mut Option<(f64, u32)>, v: f64, line: u32) {
     }
 }
 
-/// A straight stretch of a block in the workpiece frame.
+/// A stretch of a block in the workpiece frame: its XY path (a line, or an arc where the block is
+/// a G2/G3 in the workpiece's XY plane), the tip's heights at its ends (linear between), the tool
+/// axis.
 struct Piece {
-    a: P3,
-    b: P3,
+    seg: Seg,
+    z0: f64,
+    z1: f64,
     axis: V3,
 }
 
-/// The straight stretches of the controller's move from `a` to `b`: one when the rotary axes
-/// stand still (the linear axes then move the tip on a straight line), else samples of the joint
-/// interpolation spaced so that the tip moves at most `step` and the axis 0.5° between them.
+impl Piece {
+    fn line(a: &P3, b: &P3, axis: V3) -> Piece {
+        Piece { seg: Seg::Line(xy(a), xy(b)), z0: a.z, z1: b.z, axis }
+    }
+}
+
+/// The stretches of the controller's move from `a` to `b`: one when the rotary axes stand still
+/// (the linear axes then move the tip on a straight line, or on a circle for G2/G3 — an arc
+/// for the workpiece's XY plane, chords within a tenth of `step` of it otherwise), else samples of
+/// the joint interpolation spaced so that the tip moves at most `step` and the axis 0.5° between
+/// them.
 fn pieces(r: &Reading, a: &NcPose, b: &NcPose, step: f64) -> Vec<Piece> {
     let (ta, xa) = r.at(&a.joints);
     let tb = r.at(&b.joints).0;
+    if let Some(arc) = &b.arc {
+        let (start, end) = (P3::from(a.joints.xyz), P3::from(b.joints.xyz));
+        let (plane_arc, _, _) = arc.in_plane(&start, &end);
+        let tip_of = |t: f64| r.at(&crate::readback::joints_at(a, b, t)).0;
+        // In the workpiece's XY plane (the tip's height linear along it): exact arcs, each at
+        // most half a turn.
+        let parts = ((plane_arc.sweep.abs() / std::f64::consts::PI).ceil() as usize).max(1);
+        let flat = (0..=8 * parts).all(|k| {
+            let t = k as f64 / (8 * parts) as f64;
+            (tip_of(t).z - (ta.z + (tb.z - ta.z) * t)).abs() <= 1e-9
+        });
+        let exact: Option<Vec<Piece>> = flat
+            .then(|| {
+                (0..parts)
+                    .map(|i| {
+                        let (t0, t1) = (i as f64 / parts as f64, (i + 1) as f64 / parts as f64);
+                        let (p0, pm, p1) = (tip_of(t0), tip_of(0.5 * (t0 + t1)), tip_of(t1));
+                        let arc = camkit::geom::Arc2::through(&xy(&p0), &xy(&pm), &xy(&p1))?;
+                        // The circle through three of its points must hold the others too.
+                        let on = (1..8).all(|k| {
+                            let q = tip_of(t0 + (t1 - t0) * k as f64 / 8.0);
+                            camkit::geom::dist::point_arc(&xy(&q), &arc) <= 1e-9
+                        });
+                        on.then_some(Piece { seg: Seg::Arc(arc), z0: p0.z, z1: p1.z, axis: xa })
+                    })
+                    .collect()
+            })
+            .flatten();
+        if let Some(exact) = exact {
+            return exact;
+        }
+        let sag = (0.1 * step).min(plane_arc.r);
+        let n = ((plane_arc.sweep.abs() / (2.0 * (1.0 - sag / plane_arc.r).acos())).ceil() as usize).clamp(1, 100_000);
+        let mut out = Vec::with_capacity(n);
+        let mut prev = ta;
+        for k in 1..=n {
+            let now = tip_of(k as f64 / n as f64);
+            out.push(Piece::line(&prev, &now, xa));
+            prev = now;
+        }
+        return out;
+    }
     if a.joints.rot == b.joints.rot {
-        return vec![Piece { a: ta, b: tb, axis: xa }];
+        return vec![Piece::line(&ta, &tb, xa)];
     }
     let turn = (0..2).map(|k| (b.joints.rot[k] - a.joints.rot[k]).abs()).fold(0.0, f64::max);
     // The tip's path can bulge beyond its chord: bound the steps by the chord and the turn.
@@ -82,18 +135,10 @@ fn pieces(r: &Reading, a: &NcPose, b: &NcPose, step: f64) -> Vec<Piece> {
     let mut out = Vec::with_capacity(n);
     let mut prev = (ta, xa);
     for k in 1..=n {
-        let t = k as f64 / n as f64;
-        let q = camkit::kinematics::Joints {
-            xyz: a.joints.xyz + (b.joints.xyz - a.joints.xyz) * t,
-            rot: [
-                a.joints.rot[0] + (b.joints.rot[0] - a.joints.rot[0]) * t,
-                a.joints.rot[1] + (b.joints.rot[1] - a.joints.rot[1]) * t,
-            ],
-        };
-        let now = r.at(&q);
+        let now = r.at(&crate::readback::joints_at(a, b, k as f64 / n as f64));
         // The lower of the two axes' dips stands for the piece.
         let axis = if now.1.z < prev.1.z { now.1 } else { prev.1 };
-        out.push(Piece { a: prev.0, b: now.0, axis });
+        out.push(Piece::line(&prev.0, &now.0, axis));
         prev = now;
     }
     out
@@ -101,7 +146,8 @@ fn pieces(r: &Reading, a: &NcPose, b: &NcPose, step: f64) -> Vec<Piece> {
 
 /// True if the piece runs up its tool axis (to the rounding of the written words).
 fn along_axis(p: &Piece) -> bool {
-    let d = p.b - p.a;
+    let Seg::Line(a, b) = p.seg else { return false };
+    let d = V3::new(b.x - a.x, b.y - a.y, p.z1 - p.z0);
     let up = d.dot(&p.axis);
     up > 0.0 && (d - p.axis * up).norm() <= ROUNDING
 }
@@ -155,7 +201,7 @@ impl Check<'_> {
             let mut into_material = false;
             let mut into_part = false;
             for p in pieces(reading, a, b, 0.5 * job.resolution) {
-                let seg = Seg::Line(xy(&p.a), xy(&p.b));
+                let seg = p.seg;
                 let vertical = (p.axis - V3::z()).norm() <= crate::link::VERTICAL;
                 let sin = (1.0 - p.axis.z * p.axis.z).max(0.0).sqrt();
                 let dip = -(cutter.radius - cutter.corner) * sin - cutter.corner * (1.0 - p.axis.z);
@@ -165,12 +211,12 @@ impl Check<'_> {
                     let reach = if vertical {
                         cutter.radius - tol
                     } else {
-                        let height = job.stock.top() + job.approach - (p.a.z.min(p.b.z) + dip);
+                        let height = job.stock.top() + job.approach - (p.z0.min(p.z1) + dip);
                         cutter.radius + height.max(0.0) * sin / p.axis.z.max(1e-9)
                     };
-                    let mut c = map.clearance(&seg, p.a.z + dip, p.b.z + dip, reach.max(0.0)).map(|c| c.0);
+                    let mut c = map.clearance(&seg, p.z0 + dip, p.z1 + dip, reach.max(0.0)).map(|c| c.0);
                     if let (Some(d), Some(l)) = (tool.holder_diameter, tool.length) {
-                        let h = map.clearance(&seg, p.a.z + l * p.axis.z, p.b.z + l * p.axis.z, 0.5 * d).map(|c| c.0);
+                        let h = map.clearance(&seg, p.z0 + l * p.axis.z, p.z1 + l * p.axis.z, 0.5 * d).map(|c| c.0);
                         c = match (c, h) {
                             (Some(x), Some(y)) => Some(x.min(y)),
                             (x, y) => x.or(y),
@@ -198,7 +244,7 @@ impl Check<'_> {
                 if let Some(w) = self.walls
                     && vertical
                 {
-                    let c = w.clearance(&column, &seg, p.a.z, p.b.z).mm;
+                    let c = w.clearance(&column, &seg, p.z0, p.z1).mm;
                     least(if rapid { &mut o.rapid_part_clearance } else { &mut o.feed_clearance }, c, b.line);
                     if c < job.allowance - tol - 1e-9 && !into_part {
                         into_part = true;
@@ -217,7 +263,7 @@ impl Check<'_> {
                 }
                 if !rapid {
                     if vertical {
-                        map.cut(&cutter, &seg, p.a.z, p.b.z);
+                        map.cut(&cutter, &seg, p.z0, p.z1);
                     } else {
                         o.tilted_cuts += 1;
                     }

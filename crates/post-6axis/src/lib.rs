@@ -18,7 +18,7 @@ use camkit::error::{Error, Location, Result};
 use camkit::gcode::read_axes;
 use camkit::kinematics::{Chain, Solver};
 use camkit::table::{Col, Move, Table};
-use plan::{Cl, SpindleSetup};
+use plan::{Cl, ClArc, SpindleSetup};
 
 /// What the user asks of one run.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -41,15 +41,17 @@ impl Default for Settings {
     }
 }
 
-/// CL rows from a toolpath table, checked: no arcs, a tool axis on multi-axis machines, unit
-/// axes (normalised when within 1e-3 of unit, counted in the second value), a feed for every
-/// cutting row, spindle orientations only for a machine that can command them.
+/// CL rows from a toolpath table, checked: a tool axis on multi-axis machines, unit axes
+/// (normalised when within 1e-3 of unit, counted in the second value), a feed for every cutting
+/// row, spindle orientations only for a machine that can command them, arcs with a start (not the
+/// first row of a pass) and radii at both ends within `arc_tol` (mm) of each other.
 pub fn cl_rows(
     table: &Table,
     file: &str,
     chain: &Chain,
     machine: &Machine,
     feed: Option<f64>,
+    arc_tol: f64,
 ) -> Result<(Vec<Cl>, usize)> {
     let at = |line: u64, field: &str| Location::file(file).line(line).field(field);
     if !chain.rotaries().is_empty() && !table.schema.has(Col::I) {
@@ -66,11 +68,6 @@ pub fn cl_rows(
     let mut normalised = 0;
     let mut prev_path = None;
     for row in &table.rows {
-        if row.mv.is_arc() {
-            return Err(
-                Error::input("arcs (cw/ccw) are not posted: give the toolpath as lines").at(at(row.line, "move"))
-            );
-        }
         let n = row.axis.norm();
         if !n.is_finite() || (n - 1.0).abs() > camkit::tol::UNIT_VECTOR_SLACK {
             return Err(Error::input(format!("the tool axis has length {n}, not 1")).at(at(row.line, "i,j,k")));
@@ -80,6 +77,28 @@ pub fn cl_rows(
         }
         let rapid = row.mv == Move::Rapid || prev_path != Some(row.path);
         prev_path = Some(row.path);
+        let arc = match (row.mv, row.centre) {
+            (Move::Cw | Move::Ccw, _) if rapid => {
+                return Err(Error::input("an arc needs a start: the first row of a pass cannot be cw or ccw")
+                    .at(at(row.line, "move")));
+            }
+            (Move::Cw | Move::Ccw, Some(centre)) => {
+                let arc = ClArc { plane: row.plane, centre, ccw: row.mv == Move::Ccw };
+                let start: &Cl = out.last().expect("an arc follows a row of its pass");
+                let (r0, r1) = arc.radii(&start.tip, &row.pos);
+                if (r0 - r1).abs() > arc_tol || r0.is_nan() || r0 <= 0.0 {
+                    return Err(Error::input(format!(
+                        "the arc's ends are {r0:.6} and {r1:.6} mm from its centre: more than {arc_tol} mm apart, not one circle"
+                    ))
+                    .at(at(row.line, "xc,yc")));
+                }
+                Some(arc)
+            }
+            (Move::Cw | Move::Ccw, None) => {
+                return Err(Error::input("an arc needs its centre").at(at(row.line, "xc,yc")));
+            }
+            _ => None,
+        };
         let f = row.f.or(feed);
         if let Some(v) = f
             && v <= 0.0
@@ -89,7 +108,16 @@ pub fn cl_rows(
         if f.is_none() && !rapid {
             return Err(Error::input("no feed for this move: give the f column or --feed").at(at(row.line, "f")));
         }
-        out.push(Cl { tip: row.pos, axis: row.axis / n, s: row.s, feed: f, rapid, reorient: rapid, line: row.line });
+        out.push(Cl {
+            tip: row.pos,
+            axis: row.axis / n,
+            s: row.s,
+            feed: f,
+            rapid,
+            reorient: rapid,
+            line: row.line,
+            arc,
+        });
     }
     if out.is_empty() {
         return Err(Error::input("no rows: nothing to post").at(Location::file(file)));
@@ -239,7 +267,7 @@ mod tests {
                 let (th, ph) = ((tilt * (0.3 + 0.7 * t)).to_radians(), (turn * t).to_radians());
                 let axis = V3::new(th.sin() * ph.cos(), th.sin() * ph.sin(), th.cos());
                 let s = with_s.then_some(90.0 * t);
-                Cl { tip, axis, s, feed: Some(600.0), rapid: k == 0, reorient: k == 0, line: k as u64 + 2 }
+                Cl { tip, axis, s, feed: Some(600.0), rapid: k == 0, reorient: k == 0, line: k as u64 + 2, arc: None }
             })
             .collect()
     }
@@ -335,6 +363,7 @@ mod tests {
             rapid: k == 0,
             reorient: k == 0,
             line: k + 2,
+            arc: None,
         };
         let rows = [row(0.0, 20.0, 0), row(10.0, 20.0, 1), row(10.0, 22.0, 2), row(20.0, 22.0, 3)];
         let posted = post(&rows, "t", &m, &chain, &Settings::default(), vec![]).expect("posts");
@@ -365,6 +394,7 @@ mod tests {
                     rapid: k == 0,
                     reorient: k == 0,
                     line: (pass * 73 + k) as u64 + 2,
+                    arc: None,
                 });
             }
         }

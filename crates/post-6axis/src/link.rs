@@ -10,7 +10,7 @@
 //! the material map ([`camkit::collide::material`]) as the rows are linked; the collision check
 //! later measures the written program again, independently.
 
-use crate::plan::Cl;
+use crate::plan::{Cl, ClArc};
 use camkit::collide::material::{Cutter, Material};
 use camkit::collide::walls::{Column, Walls};
 use camkit::contour::Seg;
@@ -79,6 +79,36 @@ fn xy(p: &P3) -> P2 {
 fn vertical(axis: &V3) -> bool {
     (axis - V3::z()).norm() <= VERTICAL
 }
+
+/// The XY pieces of the move from `prev` to `row` with the tip's heights at their ends: a line, an
+/// arc in the XY plane exactly, chords within 0.01 mm of an arc in another plane.
+pub fn cut_pieces(prev: &P3, row: &Cl) -> Vec<(Seg, f64, f64)> {
+    match &row.arc {
+        None => vec![(Seg::Line(xy(prev), xy(&row.tip)), prev.z, row.tip.z)],
+        Some(arc) if arc.plane == camkit::geom::Plane::Xy => {
+            let (a, _, _) = arc.in_plane(prev, &row.tip);
+            vec![(Seg::Arc(a), prev.z, row.tip.z)]
+        }
+        Some(arc) => {
+            let (a, _, _) = arc.in_plane(prev, &row.tip);
+            let sag = CHORD_SAGITTA.min(a.r);
+            let n = ((a.sweep.abs() / (2.0 * (1.0 - sag / a.r).acos())).ceil() as usize).clamp(1, 100_000);
+            let mut last = *prev;
+            (1..=n)
+                .map(|k| {
+                    let p = arc.point(prev, &row.tip, k as f64 / n as f64);
+                    let piece = (Seg::Line(xy(&last), xy(&p)), last.z, p.z);
+                    last = p;
+                    piece
+                })
+                .collect()
+        }
+    }
+}
+
+/// Sagitta of the chords that stand for an arc outside the XY plane on the material map (mm):
+/// below half a cell's diagonal at any resolution the map allows, so the map stays conservative.
+const CHORD_SAGITTA: f64 = 0.01;
 
 impl<'a> Linker<'a> {
     /// A linker for `job` (with the part's walls, if it has them); `file` names the rows in
@@ -160,74 +190,88 @@ impl<'a> Linker<'a> {
     }
 
     fn row(&self, tip: P3, from: &Cl, rapid: bool, feed: Option<f64>) -> Cl {
-        Cl { tip, axis: from.axis, s: from.s, feed, rapid, reorient: false, line: from.line }
+        Cl { tip, axis: from.axis, s: from.s, feed, rapid, reorient: false, line: from.line, arc: None }
     }
 
     /// The zigzag ramp down to `start` along the first stretch of its pass (`rest`: the rows after
-    /// it), for a vertical tool on a level pass: legs to and fro along the pass's own path, the
-    /// stretch as long as two legs at the setup's ramp angle need from the material under the
-    /// start (shorter where the pass stops being level; at most [`RAMP_ROWS`] rows), descending
-    /// from the approach distance above the material under the stretch. `None` where there is
-    /// no such stretch or nothing to descend.
-    fn ramp(&self, start: &Cl, rest: &[Cl]) -> Option<(P3, Vec<P3>)> {
+    /// it), for a vertical tool on a level pass: legs to and fro along the pass's own path (its
+    /// lines and XY arcs, arcs run backwards on the way back), the stretch as long as two legs at
+    /// the setup's ramp angle need from the material under the start (shorter where the pass stops
+    /// being level; at most [`RAMP_ROWS`] rows), descending from the approach distance above the
+    /// material under the stretch. `None` where there is no such stretch or nothing to descend.
+    fn ramp(&self, start: &Cl, rest: &[Cl]) -> Option<(P3, Vec<Cl>)> {
         let angle = self.job.ramp_angle?;
         if !vertical(&start.axis) {
             return None;
         }
+        let tan = angle.to_radians().tan();
         let r = (self.cutter.radius - self.job.tolerance).max(0.0);
-        // The stretch two legs at the angle need from the material under the start.
-        let want = (self.map.highest_within(&xy(&start.tip), r) + self.job.approach - start.tip.z)
-            / (2.0 * angle.to_radians().tan());
-        let mut path = vec![start.tip];
-        let mut length = 0.0;
         let mut top = self.map.highest_within(&xy(&start.tip), r);
+        // The stretch two legs at the angle need from the material under the start.
+        let want = (top + self.job.approach - start.tip.z) / (2.0 * tan);
+        // Pieces of the stretch: (from, to, arc), level at the start's height.
+        let mut stretch: Vec<(P3, P3, Option<ClArc>)> = Vec::new();
+        let mut length = 0.0;
+        let mut from = start.tip;
         for row in rest.iter().take(RAMP_ROWS).take_while(|n| !n.rapid && vertical(&n.axis)) {
-            if (row.tip.z - start.tip.z).abs() > 1e-9 || length >= want {
+            let level =
+                (row.tip.z - start.tip.z).abs() <= 1e-9 && row.arc.is_none_or(|a| a.plane == camkit::geom::Plane::Xy);
+            if !level || length >= want {
                 break;
             }
-            let last = path[path.len() - 1];
-            top = top.max(self.map.highest_along(&Seg::Line(xy(&last), xy(&row.tip)), r));
-            length += (row.tip - last).norm();
-            path.push(row.tip);
+            for (seg, ..) in cut_pieces(&from, row) {
+                top = top.max(self.map.highest_along(&seg, r));
+                length += seg.length();
+            }
+            stretch.push((from, row.tip, row.arc));
+            from = row.tip;
         }
         let top = top + self.job.approach;
         let drop = top - start.tip.z;
         if length < RAMP_LEAST || drop <= 0.0 {
             return None;
         }
-        let run = drop / angle.to_radians().tan();
+        let run = drop / tan;
         // An even number of legs, so that the ramp ends where the pass starts.
         let legs = ((run / length).ceil() as usize).max(1).div_ceil(2) * 2;
         let leg = run / legs as f64;
-        // The stretch cut at length `leg`: its points from the start.
-        let mut out_leg = vec![];
+        // One leg out: the stretch cut at length `leg` (the last piece in part).
+        let mut out_leg: Vec<(P3, P3, Option<ClArc>)> = Vec::new();
         let mut done = 0.0;
-        for w in path.windows(2) {
-            let l = (w[1] - w[0]).norm();
+        for &(a, b, arc) in &stretch {
+            let l = cut_pieces(&a, &Cl { tip: b, arc, ..*start }).iter().map(|(s, ..)| s.length()).sum::<f64>();
             if done + l >= leg {
-                out_leg.push(w[0] + (w[1] - w[0]) * ((leg - done) / l));
+                let t = (leg - done) / l;
+                let end = match &arc {
+                    Some(c) => c.point(&a, &b, t),
+                    None => a + (b - a) * t,
+                };
+                out_leg.push((a, end, arc));
                 break;
             }
             done += l;
-            out_leg.push(w[1]);
+            out_leg.push((a, b, arc));
         }
-        let mut flat = out_leg.clone();
-        flat.extend(out_leg.iter().rev().skip(1).copied().chain(std::iter::once(start.tip)));
+        let back: Vec<(P3, P3, Option<ClArc>)> =
+            out_leg.iter().rev().map(|&(a, b, arc)| (b, a, arc.map(|c| ClArc { ccw: !c.ccw, ..c }))).collect();
         // Heights by distance run: `drop` over `legs` legs.
-        let mut points = Vec::with_capacity(flat.len() * legs / 2);
-        let mut prev = start.tip;
+        let mut rows = Vec::new();
         let mut ran = 0.0;
         for _ in 0..legs / 2 {
-            for p in &flat {
-                ran += (p - prev).norm();
-                prev = *p;
-                points.push(P3::new(p.x, p.y, top - drop * (ran / run).min(1.0)));
+            for &(a, b, arc) in out_leg.iter().chain(&back) {
+                ran += cut_pieces(&a, &Cl { tip: b, arc, ..*start }).iter().map(|(s, ..)| s.length()).sum::<f64>();
+                let z = top - drop * (ran / run).min(1.0);
+                rows.push(Cl {
+                    tip: P3::new(b.x, b.y, z),
+                    arc,
+                    ..self.row(b, start, false, Some(self.job.plunge_feed))
+                });
             }
         }
-        if let Some(last) = points.last_mut() {
-            last.z = start.tip.z;
+        if let Some(last) = rows.last_mut() {
+            last.tip = start.tip;
         }
-        Some((P3::new(start.tip.x, start.tip.y, top), points))
+        Some((P3::new(start.tip.x, start.tip.y, top), rows))
     }
 
     /// Appends the link from the last row written (or the program start) to the pass that starts
@@ -282,20 +326,18 @@ impl<'a> Linker<'a> {
             self.stats.direct += 1;
             return Ok(());
         }
-        let feed = Some(self.job.plunge_feed);
-        let points = match ramp {
-            Some((_, points)) => {
+        let rows = match ramp {
+            Some((_, rows)) => {
                 self.stats.ramps += 1;
-                points
+                rows
             }
             None => {
                 self.stats.plunges += 1;
                 self.stats.plunge_mm += (approach - start.tip).norm();
-                vec![start.tip]
+                vec![self.row(start.tip, start, false, Some(self.job.plunge_feed))]
             }
         };
-        for p in points {
-            let row = self.row(p, start, false, feed);
+        for row in rows {
             self.feed(&row);
         }
         Ok(())
@@ -307,7 +349,9 @@ impl<'a> Linker<'a> {
             && vertical(&row.axis)
             && vertical(&prev.axis)
         {
-            self.map.cut(&self.cutter, &Seg::Line(xy(&prev.tip), xy(&row.tip)), prev.tip.z, row.tip.z);
+            for (seg, z0, z1) in cut_pieces(&prev.tip, row) {
+                self.map.cut(&self.cutter, &seg, z0, z1);
+            }
         }
         self.out.push(Cl { rapid: false, reorient: false, ..*row });
     }
@@ -422,7 +466,16 @@ mod tests {
     }
 
     fn cl(x: f64, y: f64, z: f64, rapid: bool) -> Cl {
-        Cl { tip: P3::new(x, y, z), axis: V3::z(), s: None, feed: Some(800.0), rapid, reorient: rapid, line: 2 }
+        Cl {
+            tip: P3::new(x, y, z),
+            axis: V3::z(),
+            s: None,
+            feed: Some(800.0),
+            rapid,
+            reorient: rapid,
+            line: 2,
+            arc: None,
+        }
     }
 
     /// Two slots at −5: the first reached from the clearance height, the second by a retract to

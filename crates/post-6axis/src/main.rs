@@ -170,7 +170,7 @@ fn run(args: Args) -> Result<()> {
         return finish(out, &args, report);
     }
     let t = table::read(&input, &[Col::X, Col::Y])?;
-    let (rows, normalised) = cl_rows(&t, &input.name, &chain, &machine, settings.feed)?;
+    let (rows, normalised) = cl_rows(&t, &input.name, &chain, &machine, settings.feed, settings.tol)?;
     if normalised > 0 {
         cli::warn(&format!("{normalised} tool axes were not unit vectors (within 1e-3): normalised"));
     }
@@ -214,17 +214,15 @@ fn run(args: Args) -> Result<()> {
             link_keys(&mut report, &linked.stats);
             linked.rows
         }
-        None => {
-            let passes = rows.iter().filter(|r| r.rapid).count();
-            if passes > 1 {
-                cli::warn(&format!(
-                    "{passes} passes joined by straight G0 moves as given, not linked or checked against the stock: give --setup"
-                ));
-            }
-            rows
-        }
+        None => rows,
     };
     let posted = post(&rows, &input.name, &machine, &chain, &settings, comments)?;
+    let passes = rows.iter().filter(|r| r.rapid).count();
+    if job.is_none() && passes > 1 {
+        cli::warn(&format!(
+            "{passes} passes joined by straight G0 moves as given, not linked or checked against the stock: give --setup"
+        ));
+    }
     if let Some(j) = &job {
         collide(&posted.text, &machine, &chain, j, walls.as_ref(), &args, &mut report)?;
     }

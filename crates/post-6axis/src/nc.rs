@@ -1,10 +1,14 @@
 //! Writing the NC program: header, tool change, spindle and coolant, motion blocks in G0/G1 with
-//! inverse-time feed (G93) for blocks that turn a rotary axis and G94 otherwise, the spindle
-//! orientation as `M19 R` or a rotary address, footer; fixed decimals per address, optional block
-//! numbers, in the ISO/Fanuc or LinuxCNC dialect.
+//! inverse-time feed (G93) for blocks that turn a rotary axis and G94 otherwise, arcs as G2/G3 in
+//! their plane (G17/G18/G19) with I/J/K from the start as written, the spindle orientation as
+//! `M19 R` or a rotary address, footer; fixed decimals per address, optional block numbers, in the
+//! ISO/Fanuc or LinuxCNC dialect. The first move never runs diagonally from the tool change: from
+//! a known retract height (`program.retract_z`) the other axes move first, then Z comes down;
+//! otherwise Z moves first.
 
 use crate::plan::Step;
 use camkit::doc::machine::{Coolant, Dialect, Machine, SpindleMode, UnitsDoc};
+use camkit::geom::Plane;
 use camkit::kinematics::Chain;
 use camkit::num::{push_fixed, round_to};
 
@@ -29,6 +33,8 @@ pub struct Written {
     pub orients: usize,
     /// Blocks dropped because nothing moved once rounded.
     pub dropped: usize,
+    /// Arcs written (G2/G3).
+    pub arcs: usize,
 }
 
 /// A block with no feed: the row it comes from.
@@ -148,11 +154,44 @@ pub fn write(
     let mut inverse_time = false;
     let mut g94_feed: Option<f64> = None;
     let mut motion: Option<u8> = None;
+    let mut plane = Plane::Xy;
     let mut prev: Option<&Step> = None;
     for step in steps {
         let lin: [f64; 3] = std::array::from_fn(|k| round_to(step.joints.xyz[k] / unit, d.linear));
         let rot: [f64; 2] = std::array::from_fn(|k| round_to(step.joints.rot[k], d.rotary));
         let spin = step.spindle.map(|s| round_to(s, d.rotary));
+        if prev.is_none() {
+            // The first move: Z alone first, or (from a known retract height) everything else
+            // first, so that it never runs diagonally down from the tool change position.
+            o.block();
+            o.text.extend_from_slice(b"G0");
+            motion = Some(0);
+            if retract.is_some() {
+                o.word(b'X', lin[0], d.linear);
+                o.word(b'Y', lin[1], d.linear);
+                let mut words: Vec<(u8, f64)> = (0..letters.len()).map(|k| (letters[k], rot[k])).collect();
+                if spindle_mode == Some(SpindleMode::Axis)
+                    && let (Some(l), Some(sp)) = (spindle_letter, spin)
+                {
+                    words.push((l, sp));
+                    last_spin = Some(sp);
+                }
+                words.sort_by_key(|w| w.0);
+                for (l, v) in words {
+                    o.word(l, v, d.rotary);
+                }
+                last_lin[0] = Some(lin[0]);
+                last_lin[1] = Some(lin[1]);
+                for k in 0..letters.len() {
+                    last_rot[k] = Some(rot[k]);
+                }
+            } else {
+                o.word(b'Z', lin[2], d.linear);
+                last_lin[2] = Some(lin[2]);
+            }
+            o.end();
+            stats.blocks += 1;
+        }
         if spindle_mode == Some(SpindleMode::M19)
             && let Some(s) = spin
         {
@@ -172,15 +211,39 @@ pub fn write(
         let spin_axis = spindle_mode == Some(SpindleMode::Axis);
         let spin_changed = spin_axis && spin.is_some() && last_spin != spin;
         let rapid = step.cl.rapid || prev.is_none();
-        if !lin_changed.iter().any(|c| *c) && !rot_changed.iter().any(|c| *c) && !spin_changed {
+        let arc = step.arc.filter(|_| !rapid);
+        if !lin_changed.iter().any(|c| *c) && !rot_changed.iter().any(|c| *c) && !spin_changed && arc.is_none() {
             stats.dropped += 1;
             continue;
         }
         let rotary_moves = rot_changed.iter().any(|c| *c) || spin_changed;
+        if let Some(a) = &arc
+            && a.plane != plane
+        {
+            o.line(match a.plane {
+                Plane::Xy => "G17",
+                Plane::Xz => "G18",
+                Plane::Yz => "G19",
+            });
+            plane = a.plane;
+        }
         o.block();
         if rapid {
             o.text.extend_from_slice(b"G0");
             motion = Some(0);
+        } else if let Some(a) = &arc {
+            if inverse_time {
+                o.text.extend_from_slice(b"G94 ");
+                inverse_time = false;
+                g94_feed = None;
+            }
+            let g = if a.ccw { 3 } else { 2 };
+            if motion != Some(g) {
+                o.text.extend_from_slice(if a.ccw { b"G3" } else { b"G2" });
+                motion = Some(g);
+            } else if o.text.last() == Some(&b' ') {
+                o.text.pop();
+            }
         } else {
             let want_inverse = rotary_moves && !p.tcp;
             if want_inverse && !inverse_time {
@@ -213,9 +276,23 @@ pub fn write(
         for (l, v) in words {
             o.word(l, v, d.rotary);
         }
+        if let Some(a) = &arc {
+            // The centre from the start as written (rounded), in program units.
+            let [iu, iv, _] = a.plane.axes();
+            let mut centre = [0.0; 3];
+            centre[iu] = a.centre.x / unit;
+            centre[iv] = a.centre.y / unit;
+            let mut ks = [iu, iv];
+            ks.sort_unstable();
+            for k in ks {
+                let start = last_lin[k].expect("an arc follows a written block");
+                o.word(b"IJK"[k], round_to(centre[k] - start, d.linear), d.linear);
+            }
+            stats.arcs += 1;
+        }
         if !rapid {
             let feed = step.cl.feed.ok_or(NoFeed(step.row))?;
-            if inverse_time {
+            if inverse_time && arc.is_none() {
                 let a = prev.expect("a feed block follows another block");
                 let tip_len = (step.cl.tip - a.cl.tip).norm();
                 let mut turn = 0.0f64;

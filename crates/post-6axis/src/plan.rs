@@ -4,8 +4,79 @@
 //! interpolation of every axis keeps the tool tip within `tol` of the straight CL segment and the
 //! tool axis within `angle_tol` of the great-circle arc between the end axes.
 
-use camkit::geom::{P3, V3};
+use camkit::geom::dist::point_arc;
+use camkit::geom::{Arc2, P2, P3, Plane, V3};
 use camkit::kinematics::{Chain, Joints, M3, Solver, principal_deg};
+
+/// An arc of the toolpath in the workpiece frame: from the previous row's tip to this row's,
+/// about `centre` (in the plane's (u, v) coordinates, [`Plane::split`]), turning counter-clockwise
+/// in (u, v) if `ccw` (G3); the coordinate along the plane's normal changes linearly (a helix).
+/// Ends that coincide make a full circle.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ClArc {
+    /// The arc's plane.
+    pub plane: Plane,
+    /// Centre, in the plane's coordinates.
+    pub centre: P2,
+    /// Counter-clockwise in the plane's coordinates.
+    pub ccw: bool,
+}
+
+impl ClArc {
+    /// The arc in plane coordinates from `a` to `b`, and the normal coordinates at both ends.
+    pub fn in_plane(&self, a: &P3, b: &P3) -> (Arc2, f64, f64) {
+        let (pa, wa) = self.plane.split(a);
+        let (pb, wb) = self.plane.split(b);
+        (Arc2::from_centre(self.centre, &pa, &pb, self.ccw, true), wa, wb)
+    }
+
+    /// The point at fraction `t` of the arc from `a` to `b`.
+    pub fn point(&self, a: &P3, b: &P3, t: f64) -> P3 {
+        let (arc, wa, wb) = self.in_plane(a, b);
+        self.plane.join(&arc.point_at_fraction(t), wa + (wb - wa) * t)
+    }
+
+    /// Distance from `p` to the arc from `a` to `b`: exact for a planar arc, within 1e-9 of it for
+    /// a helix (samples refined by golden-section search).
+    pub fn distance(&self, p: &P3, a: &P3, b: &P3) -> f64 {
+        let (arc, wa, wb) = self.in_plane(a, b);
+        let (q, w) = self.plane.split(p);
+        if wa == wb {
+            return point_arc(&q, &arc).hypot(w - wa);
+        }
+        let at = |t: f64| (self.plane.join(&arc.point_at_fraction(t), wa + (wb - wa) * t) - p).norm();
+        let n = 64;
+        let k = (0..=n).min_by(|&i, &j| at(i as f64 / n as f64).total_cmp(&at(j as f64 / n as f64))).unwrap_or(0);
+        let (mut lo, mut hi) = ((k.max(1) - 1) as f64 / n as f64, ((k + 1).min(n)) as f64 / n as f64);
+        let g = 0.5 * (5f64.sqrt() - 1.0);
+        for _ in 0..60 {
+            let (c, d) = (hi - g * (hi - lo), lo + g * (hi - lo));
+            if at(c) <= at(d) {
+                hi = d;
+            } else {
+                lo = c;
+            }
+        }
+        at(0.5 * (lo + hi)).min(at(k as f64 / n as f64))
+    }
+
+    /// Radius at the start and at the end.
+    pub fn radii(&self, a: &P3, b: &P3) -> (f64, f64) {
+        ((self.plane.split(a).0 - self.centre).norm(), (self.plane.split(b).0 - self.centre).norm())
+    }
+}
+
+/// An arc the controller runs (G2/G3): its plane among G17/G18/G19, centre in the controller's
+/// plane coordinates, direction.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct StepArc {
+    /// G17, G18 or G19.
+    pub plane: Plane,
+    /// Centre in the plane's coordinates (controller X, Y, Z).
+    pub centre: P2,
+    /// G3.
+    pub ccw: bool,
+}
 
 /// One CL row as the post needs it.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -25,6 +96,8 @@ pub struct Cl {
     pub reorient: bool,
     /// Source line, for messages.
     pub line: u64,
+    /// The row is reached along an arc from the previous row.
+    pub arc: Option<ClArc>,
 }
 
 /// How the spindle orientation is commanded, for planning.
@@ -81,6 +154,8 @@ pub struct Step {
     pub inserted: bool,
     /// The primary axis was held or interpolated here (singular cone).
     pub singular: bool,
+    /// The controller reaches this block along an arc (G2/G3).
+    pub arc: Option<StepArc>,
 }
 
 /// Figures of a plan.
@@ -100,6 +175,11 @@ pub struct Stats {
     pub axis_deviation: f64,
     /// Largest angle (radians) between a pose's tool axis and its CL row's (singular cone).
     pub pose_axis_error: f64,
+    /// Arcs written as G2/G3.
+    pub arcs: usize,
+    /// Arcs linearised (the rotary axes move over them, or their plane is not one of the
+    /// controller's).
+    pub arcs_linearised: usize,
 }
 
 /// Why planning failed: the row (index) and what is wrong.
@@ -265,6 +345,7 @@ fn poses(rows: &[Cl], m: &Machine, opts: &Options, stats: &mut Stats) -> Result<
             row: i,
             inserted: false,
             singular: c.singular,
+            arc: None,
         });
     }
     Ok(steps)
@@ -388,12 +469,18 @@ const MAX_DEPTH: u32 = 24;
 /// The pose for an inserted block at fraction `t` of the segment `a`–`b`.
 fn inserted(m: &Machine, opts: &Options, a: &Step, b: &Step, t: f64) -> Result<Step, PlanError> {
     let tip = a.cl.tip + (b.cl.tip - a.cl.tip) * t;
+    pose_at(m, opts, a, b, tip, t)
+}
+
+/// The pose for a block at fraction `t` of the move from `a` to `b` with its tip at `tip`: the
+/// axis and spindle orientation interpolated, the IK solution nearest `a`'s.
+fn pose_at(m: &Machine, opts: &Options, a: &Step, b: &Step, tip: P3, t: f64) -> Result<Step, PlanError> {
     let axis = slerp(&a.cl.axis, &b.cl.axis, t);
     let s = match (a.cl.s, b.cl.s) {
         (Some(x), Some(y)) => Some(x + principal_deg(y - x) * t),
         _ => b.cl.s,
     };
-    let cl = Cl { tip, axis, s, feed: b.cl.feed, rapid: false, reorient: false, line: b.cl.line };
+    let cl = Cl { tip, axis, s, feed: b.cl.feed, rapid: false, reorient: false, line: b.cl.line, arc: None };
     let chain = m.chain();
     let singular = a.singular || b.singular;
     let c = if singular && chain.rotaries().len() == 2 {
@@ -406,7 +493,87 @@ fn inserted(m: &Machine, opts: &Options, a: &Step, b: &Step, t: f64) -> Result<S
     let (xyz, frame) = m.linear(&tip, &c.rot, opts.tcp);
     m.check_travel(&xyz).map_err(|message| PlanError { row: b.row, message, unreachable: true })?;
     let spindle = m.spindle_in(&frame, s, a.spindle).filter(|_| s.is_some());
-    Ok(Step { joints: Joints { xyz, rot: c.rot }, spindle, cl, row: b.row, inserted: true, singular })
+    Ok(Step { joints: Joints { xyz, rot: c.rot }, spindle, cl, row: b.row, inserted: true, singular, arc: None })
+}
+
+/// The controller's arc for the CL arc from `a` to `b`, when the controller can run it as G2/G3:
+/// the rotary axes (and the spindle orientation) stand still over it, and the chain maps the
+/// arc's plane onto one of the controller's (in TCP mode X, Y, Z are the tip: always). `None`
+/// otherwise.
+fn controller_arc(m: &Machine, opts: &Options, a: &Step, b: &Step, arc: &ClArc) -> Option<StepArc> {
+    if a.joints.rot != b.joints.rot || a.spindle != b.spindle {
+        return None;
+    }
+    let rot = &b.joints.rot;
+    let map = |p: &P3| m.linear(p, rot, opts.tcp).0;
+    let normal = arc.plane.join(&P2::origin(), 1.0).coords;
+    let image = map(&(b.cl.tip + normal)) - map(&b.cl.tip);
+    let (plane, sign) = [Plane::Yz, Plane::Xz, Plane::Xy].into_iter().enumerate().find_map(|(k, plane)| {
+        let e = V3::ith(k, 1.0);
+        if (image - e).norm() <= PLANE_SLACK {
+            Some((plane, true))
+        } else if (image + e).norm() <= PLANE_SLACK {
+            Some((plane, false))
+        } else {
+            None
+        }
+    })?;
+    let (_, wa) = arc.plane.split(&a.cl.tip);
+    let centre = plane.split(&P3::from(map(&arc.plane.join(&arc.centre, wa)))).0;
+    Some(StepArc { plane, centre, ccw: arc.ccw == sign })
+}
+
+/// How far from a controller axis the image of an arc's plane normal may be (it is a rotation of
+/// a unit vector: round-off only).
+const PLANE_SLACK: f64 = 1e-9;
+
+/// Samples of an arc checked against the travel limits.
+const ARC_TRAVEL_SAMPLES: usize = 64;
+
+/// Plans the CL arc from `a` to `b`: one G2/G3 block where the controller can run it, else chords
+/// whose sagitta is at most half the tolerance, each linearised within the other half.
+fn plan_arc(
+    m: &Machine,
+    opts: &Options,
+    a: &Step,
+    b: &Step,
+    arc: &ClArc,
+    out: &mut Vec<Step>,
+    stats: &mut Stats,
+) -> Result<(), PlanError> {
+    if let Some(sa) = controller_arc(m, opts, a, b, arc) {
+        for k in 1..ARC_TRAVEL_SAMPLES {
+            let p = arc.point(&a.cl.tip, &b.cl.tip, k as f64 / ARC_TRAVEL_SAMPLES as f64);
+            m.check_travel(&m.linear(&p, &b.joints.rot, opts.tcp).0).map_err(|message| PlanError {
+                row: b.row,
+                message,
+                unreachable: true,
+            })?;
+        }
+        stats.arcs += 1;
+        out.push(Step { arc: Some(sa), ..*b });
+        return Ok(());
+    }
+    stats.arcs_linearised += 1;
+    let (plane_arc, _, _) = arc.in_plane(&a.cl.tip, &b.cl.tip);
+    let half = 0.5 * opts.tol;
+    let step = if plane_arc.r > half { 2.0 * (1.0 - half / plane_arc.r).acos() } else { std::f64::consts::PI };
+    let n = ((plane_arc.sweep.abs() / step).ceil() as usize).max(1);
+    let chord =
+        Options { tol: opts.tol - plane_arc.r * (1.0 - (0.5 * plane_arc.sweep.abs() / n as f64).cos()), ..*opts };
+    let mut prev = *a;
+    for k in 1..=n {
+        let t = k as f64 / n as f64;
+        let next = if k == n {
+            *b
+        } else {
+            stats.inserted += 1;
+            pose_at(m, opts, a, b, arc.point(&a.cl.tip, &b.cl.tip, t), t)?
+        };
+        linearise(m, &chord, &prev, &next, 0, out, stats)?;
+        prev = *out.last().expect("the chord ends at its block");
+    }
+    Ok(())
 }
 
 fn linearise(
@@ -470,7 +637,10 @@ pub fn plan(rows: &[Cl], m: &Machine, opts: &Options) -> Result<(Vec<Step>, Stat
             continue;
         }
         let a = *out.last().expect("a previous block");
-        linearise(m, opts, &a, step, 0, &mut out, &mut stats)?;
+        match &step.cl.arc {
+            Some(arc) => plan_arc(m, opts, &a, step, arc, &mut out, &mut stats)?,
+            None => linearise(m, opts, &a, step, 0, &mut out, &mut stats)?,
+        }
     }
     Ok((out, stats))
 }

@@ -5,8 +5,8 @@
 
 use crate::plan::{Cl, point_segment, slerp, vector_arc};
 use camkit::doc::machine::{Machine, SpindleMode};
-use camkit::gcode::{AXIS_LETTERS, AxisProgram, Motion};
-use camkit::geom::{P3, V3};
+use camkit::gcode::{AXIS_LETTERS, AxisArc, AxisProgram, Motion};
+use camkit::geom::{P2, P3, Plane, V3};
 use camkit::kinematics::{Chain, Joints, principal_deg};
 use camkit::table::{Col, Move, Row, Schema, Table};
 use rayon::prelude::*;
@@ -44,6 +44,8 @@ pub struct NcPose {
     pub line: u32,
     /// G0.
     pub rapid: bool,
+    /// The circle of a G2/G3 block (controller X, Y, Z).
+    pub arc: Option<AxisArc>,
     /// Controller values.
     pub joints: Joints,
     /// Controller spindle angle, if commanded so far.
@@ -80,6 +82,7 @@ pub fn poses(prog: &AxisProgram, r: &Reading) -> Vec<Option<NcPose>> {
             Some(NcPose {
                 line: m.line,
                 rapid: m.motion == Motion::Rapid,
+                arc: m.arc,
                 joints: Joints { xyz: V3::new(m.pos[0], m.pos[1], m.pos[2]), rot },
                 sigma,
                 inverse_time: m.inverse_time,
@@ -87,6 +90,42 @@ pub fn poses(prog: &AxisProgram, r: &Reading) -> Vec<Option<NcPose>> {
             })
         })
         .collect()
+}
+
+/// Controller values at fraction `t` of the block from `a` to `b`: every axis linearly, or the
+/// linear axes along the block's circle.
+pub fn joints_at(a: &NcPose, b: &NcPose, t: f64) -> Joints {
+    let xyz = match &b.arc {
+        Some(arc) => arc.point(&P3::from(a.joints.xyz), &P3::from(b.joints.xyz), t).coords,
+        None => a.joints.xyz + (b.joints.xyz - a.joints.xyz) * t,
+    };
+    Joints {
+        xyz,
+        rot: [
+            a.joints.rot[0] + (b.joints.rot[0] - a.joints.rot[0]) * t,
+            a.joints.rot[1] + (b.joints.rot[1] - a.joints.rot[1]) * t,
+        ],
+    }
+}
+
+/// Samples a block needs: `base`, or more for an arc (one every π/64 of its sweep).
+pub fn samples_of(a: &NcPose, b: &NcPose, base: usize) -> usize {
+    match &b.arc {
+        Some(arc) => {
+            let sweep = arc.in_plane(&P3::from(a.joints.xyz), &P3::from(b.joints.xyz)).0.sweep.abs();
+            base.max((sweep / (std::f64::consts::PI / 64.0)).ceil() as usize)
+        }
+        None => base,
+    }
+}
+
+/// Distance from `p` to the CL path between rows `a` and `b`: the segment, or the arc `b`
+/// arrives along.
+pub fn cl_distance(p: &P3, a: &Cl, b: &Cl) -> f64 {
+    match &b.arc {
+        Some(arc) => arc.distance(p, &a.tip, &b.tip),
+        None => point_segment(p, &a.tip, &b.tip),
+    }
 }
 
 impl Reading<'_> {
@@ -136,14 +175,14 @@ fn nearest(p: &P3, cl: &[Cl], segs: &[(usize, usize)], hint: usize, far: f64) ->
     let hi = (hint + 16).min(segs.len());
     let mut best = (hint.min(segs.len().saturating_sub(1)), f64::INFINITY);
     for (k, &(a, b)) in segs.iter().enumerate().take(hi).skip(lo) {
-        let d = point_segment(p, &cl[a].tip, &cl[b].tip);
+        let d = cl_distance(p, &cl[a], &cl[b]);
         if d < best.1 {
             best = (k, d);
         }
     }
     if best.1 > far {
         for (k, &(a, b)) in segs.iter().enumerate() {
-            let d = point_segment(p, &cl[a].tip, &cl[b].tip);
+            let d = cl_distance(p, &cl[a], &cl[b]);
             if d < best.1 {
                 best = (k, d);
             }
@@ -190,7 +229,7 @@ pub fn verify(cl: &[Cl], poses: &[Option<NcPose>], r: &Reading, samples_per_bloc
         }
         prev = Some(b);
     }
-    let path: Vec<P3> = poses.par_iter().filter_map(|p| p.as_ref()).map(|p| r.at(&p.joints).0).collect();
+    let path = program_path(poses, r, tol);
     let mut dev = Deviation::default();
     if !segs.is_empty() {
         // The first chunk starts its search at the first segment, as a sequential check would.
@@ -240,6 +279,31 @@ pub fn verify(cl: &[Cl], poses: &[Option<NcPose>], r: &Reading, samples_per_bloc
     dev
 }
 
+/// The program's path in the workpiece frame: every block's end, and points along each arc close
+/// enough that the chords stay within a twentieth of `tol` of it.
+fn program_path(poses: &[Option<NcPose>], r: &Reading, tol: f64) -> Vec<P3> {
+    let known: Vec<&NcPose> = poses.iter().filter_map(|p| p.as_ref()).collect();
+    let parts: Vec<Vec<P3>> = (0..known.len())
+        .into_par_iter()
+        .map(|i| {
+            let b = known[i];
+            let mut out = Vec::new();
+            if let (Some(arc), Some(a)) = (&b.arc, i.checked_sub(1).map(|k| known[k])) {
+                let (plane_arc, _, _) = arc.in_plane(&P3::from(a.joints.xyz), &P3::from(b.joints.xyz));
+                let sag = (tol / 20.0).min(plane_arc.r);
+                let step = 2.0 * (1.0 - sag / plane_arc.r).acos();
+                let n = ((plane_arc.sweep.abs() / step).ceil() as usize).clamp(1, 1_000_000);
+                for k in 1..n {
+                    out.push(r.at(&joints_at(a, b, k as f64 / n as f64)).0);
+                }
+            }
+            out.push(r.at(&b.joints).0);
+            out
+        })
+        .collect();
+    parts.concat()
+}
+
 /// Index of the program path's segment (or last point) nearest `p` and its distance: searched
 /// near `hint` first, everywhere when there is no hint or nothing within `far` near it.
 fn nearest_on_path(p: &P3, path: &[P3], hint: Option<usize>, far: f64) -> (usize, f64) {
@@ -284,7 +348,7 @@ fn axis_deviation(tip: &P3, axis: &V3, cl: &[Cl], segs: &[(usize, usize)], seg: 
         [seg.checked_sub(1).filter(|&k| segs[k].1 == i0), Some(seg + 1).filter(|&k| k < segs.len() && segs[k].0 == i1)];
     for k in neighbours.into_iter().flatten() {
         let (a, b) = segs[k];
-        let dk = point_segment(tip, &cl[a].tip, &cl[b].tip);
+        let dk = cl_distance(tip, &cl[a], &cl[b]);
         if dk <= tol {
             best = best.min(at(k, dk));
         }
@@ -306,15 +370,10 @@ fn check_blocks(
     let mut dev = Deviation::default();
     for &(a, b) in blocks {
         dev.blocks += 1;
-        for k in 0..=samples_per_block {
-            let t = k as f64 / samples_per_block as f64;
-            let q = Joints {
-                xyz: a.joints.xyz + (b.joints.xyz - a.joints.xyz) * t,
-                rot: [
-                    a.joints.rot[0] + (b.joints.rot[0] - a.joints.rot[0]) * t,
-                    a.joints.rot[1] + (b.joints.rot[1] - a.joints.rot[1]) * t,
-                ],
-            };
+        let samples = samples_of(a, b, samples_per_block);
+        for k in 0..=samples {
+            let t = k as f64 / samples as f64;
+            let q = joints_at(a, b, t);
             let (tip, axis) = r.at(&q);
             // Without a hint (a chunk but the first), a full search (a negative `far`).
             let (seg, d) = match hint {
@@ -351,35 +410,116 @@ fn check_blocks(
 }
 
 /// The program as a toolpath table: tool tip, axis, spindle orientation and feed (mm/min) per
-/// block; a new `path` after every run of rapids.
+/// block; a new `path` after every run of rapids. Arcs become `cw`/`ccw` rows (split where they
+/// turn more than once) in the workpiece plane the controller's plane maps onto, or lines along
+/// them (chords within 1 µm) where it maps onto none.
 pub fn reverse(poses: &[Option<NcPose>], r: &Reading) -> Table {
     let mut rows = Vec::new();
     let mut path = 0i64;
     let mut last: Option<(P3, bool)> = None;
+    let mut prev: Option<&NcPose> = None;
     let has_s = r.spindle.is_some();
-    for pose in poses.iter().flatten() {
+    let mut planes = Vec::new();
+    for pose in poses.iter() {
+        let Some(pose) = pose else {
+            prev = None;
+            continue;
+        };
         let (tip, axis) = r.at(&pose.joints);
         if pose.rapid && last.is_some_and(|(_, rapid)| !rapid) {
             path += 1;
         }
-        let mut row = Row::at(path, tip);
-        row.mv = if pose.rapid { Move::Rapid } else { Move::Line };
-        row.axis = axis;
-        row.s = pose.sigma.and_then(|s| r.s_of(&pose.joints.rot, s));
-        row.line = u64::from(pose.line);
-        if !pose.rapid {
-            row.f = match (pose.inverse_time, pose.feed, last) {
-                (false, f, _) => f,
-                (true, Some(f), Some((p, _))) => Some(f * (tip - p).norm()),
-                _ => None,
-            };
+        let row_at = |tip: P3| {
+            let mut row = Row::at(path, tip);
+            row.mv = if pose.rapid { Move::Rapid } else { Move::Line };
+            row.axis = axis;
+            row.s = pose.sigma.and_then(|s| r.s_of(&pose.joints.rot, s));
+            row.line = u64::from(pose.line);
+            row
+        };
+        let feed = match (pose.rapid, pose.inverse_time, pose.feed, last) {
+            (true, ..) => None,
+            (false, false, f, _) => f,
+            (false, true, Some(f), Some((p, _))) => Some(f * (tip - p).norm()),
+            _ => None,
+        };
+        match (&pose.arc, prev) {
+            (Some(arc), Some(a)) if !pose.rapid => {
+                for mut row in arc_rows(arc, a, pose, r) {
+                    let t = row.pos;
+                    row.axis = axis;
+                    row.s = pose.sigma.and_then(|s| r.s_of(&pose.joints.rot, s));
+                    row.line = u64::from(pose.line);
+                    row.path = path;
+                    row.f = feed;
+                    planes.push(row.plane);
+                    rows.push(row);
+                    last = Some((t, false));
+                }
+            }
+            _ => {
+                let mut row = row_at(tip);
+                row.f = feed;
+                last = Some((tip, pose.rapid));
+                rows.push(row);
+            }
         }
-        last = Some((tip, pose.rapid));
-        rows.push(row);
+        prev = Some(pose);
     }
     let mut schema = Schema::of(&[Col::Path, Col::Move, Col::X, Col::Y, Col::Z, Col::I, Col::J, Col::K, Col::F]);
+    if rows.iter().any(|r| r.mv.is_arc()) {
+        schema.add(&[Col::Xc, Col::Yc]);
+        if planes.iter().any(|p| *p != Plane::Xy) {
+            schema.add(&[Col::Zc, Col::Plane]);
+        }
+    }
     if has_s {
         schema.add(&[Col::S]);
     }
     Table { schema, rows }
+}
+
+/// The rows of a G2/G3 block from `a` to `b` in the workpiece frame (position, move, centre,
+/// plane set; the caller fills the rest).
+fn arc_rows(arc: &AxisArc, a: &NcPose, b: &NcPose, r: &Reading) -> Vec<Row> {
+    let rot = b.joints.rot;
+    let tip_of = |xyz: V3| r.at(&Joints { xyz, rot }).0;
+    let normal = arc.plane.join(&P2::origin(), 1.0).coords;
+    let image = tip_of(b.joints.xyz + normal) - tip_of(b.joints.xyz);
+    let (start, end) = (P3::from(a.joints.xyz), P3::from(b.joints.xyz));
+    let pieces = arc.turns as usize + 1;
+    let found = [Plane::Yz, Plane::Xz, Plane::Xy].into_iter().enumerate().find_map(|(k, plane)| {
+        let e = V3::ith(k, 1.0);
+        if (image - e).norm() <= 1e-9 {
+            Some((plane, true))
+        } else if (image + e).norm() <= 1e-9 {
+            Some((plane, false))
+        } else {
+            None
+        }
+    });
+    let Some((plane, sign)) = found else {
+        // No workpiece plane holds it: lines along it, chords within 1 µm.
+        let (p, _, _) = arc.in_plane(&start, &end);
+        let step = 2.0 * (1.0 - (0.001f64).min(p.r) / p.r).acos();
+        let n = ((p.sweep.abs() / step).ceil() as usize).clamp(1, 1_000_000);
+        return (1..=n)
+            .map(|k| {
+                let mut row = Row::at(0, tip_of(arc.point(&start, &end, k as f64 / n as f64).coords));
+                row.mv = Move::Line;
+                row
+            })
+            .collect();
+    };
+    let (_, w0) = arc.plane.split(&start);
+    let centre = plane.split(&tip_of(arc.plane.join(&arc.centre, w0).coords)).0;
+    (1..=pieces)
+        .map(|k| {
+            let mut row = Row::at(0, tip_of(arc.point(&start, &end, k as f64 / pieces as f64).coords));
+            row.mv = if arc.ccw == sign { Move::Ccw } else { Move::Cw };
+            row.centre = Some(centre);
+            row.plane = plane;
+            row
+        })
+        .collect()
 }

@@ -88,19 +88,19 @@ fn unit(v: V3, file: &str, line: u64) -> Result<V3> {
     Ok(v / n)
 }
 
-/// End points of the chords of the move ending at row `b` (one point for a line).
+/// End points of the chords of the move ending at row `b` (one point for a line); an arc in its
+/// plane (xy, xz or yz: the coordinate across it linear), its radius going linearly from the
+/// start's to the end's.
 fn chord_points(start: P3, b: &camkit::table::Row, file: &str) -> Result<Vec<P3>> {
     if !b.mv.is_arc() {
         return Ok(vec![b.pos]);
     }
-    if b.plane != camkit::geom::Plane::Xy {
-        return Err(Error::input("only arcs in the xy plane are simulated: convert others to lines")
-            .at(Location::file(file).line(b.line).field("plane")));
-    }
     let c = b
         .centre
         .ok_or_else(|| Error::input("arc without centre").at(Location::file(file).line(b.line).field("xc,yc")))?;
-    let (a0, a1) = ((start.y - c.y).atan2(start.x - c.x), (b.pos.y - c.y).atan2(b.pos.x - c.x));
+    let (s, ws) = b.plane.split(&start);
+    let (e, we) = b.plane.split(&b.pos);
+    let (a0, a1) = ((s.y - c.y).atan2(s.x - c.x), (e.y - c.y).atan2(e.x - c.x));
     let ccw = b.mv == Kind::Ccw;
     let mut sweep = a1 - a0;
     if ccw && sweep <= 0.0 {
@@ -109,7 +109,7 @@ fn chord_points(start: P3, b: &camkit::table::Row, file: &str) -> Result<Vec<P3>
     if !ccw && sweep >= 0.0 {
         sweep -= 2.0 * PI;
     }
-    let (r0, r1) = ((start.x - c.x).hypot(start.y - c.y), (b.pos.x - c.x).hypot(b.pos.y - c.y));
+    let (r0, r1) = ((s - c).norm(), (e - c).norm());
     let rad = r0.max(r1);
     let step = if rad > ARC_CHORD { 2.0 * (1.0 - ARC_CHORD / rad).acos() } else { PI };
     let n = ((sweep.abs() / step).ceil() as usize).clamp(1, 100_000);
@@ -118,7 +118,8 @@ fn chord_points(start: P3, b: &camkit::table::Row, file: &str) -> Result<Vec<P3>
             let t = k as f64 / n as f64;
             let ang = a0 + sweep * t;
             let rr = r0 + (r1 - r0) * t;
-            P3::new(c.x + rr * ang.cos(), c.y + rr * ang.sin(), start.z + (b.pos.z - start.z) * t)
+            let q = camkit::geom::P2::new(c.x + rr * ang.cos(), c.y + rr * ang.sin());
+            b.plane.join(&q, ws + (we - ws) * t)
         })
         .collect())
 }
@@ -208,4 +209,43 @@ pub fn simulate(cutter: &Cutter, moves: &[Move], grid: &Grid) -> HeightMap {
         }
     }
     HeightMap { grid: *grid, h: out }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use camkit::geom::{P2, Plane};
+    use camkit::table::Row;
+
+    /// An arc in each plane: every chord end on its circle (radius 5 about the centre, within
+    /// round-off), the coordinate across the plane linear, the end reached.
+    #[test]
+    fn arcs_in_every_plane_become_chords_on_their_circle() {
+        for (plane, end, centre) in [
+            (Plane::Xy, P3::new(0.0, 10.0, -1.0), P2::new(0.0, 5.0)),
+            (Plane::Xz, P3::new(0.0, 2.0, 10.0), P2::new(5.0, 0.0)),
+            (Plane::Yz, P3::new(3.0, 10.0, 0.0), P2::new(5.0, 0.0)),
+        ] {
+            let mut b = Row::at(0, end);
+            b.mv = Kind::Cw;
+            b.plane = plane;
+            b.centre = Some(centre);
+            let start = match plane {
+                Plane::Xy => P3::new(0.0, 0.0, 1.0),
+                Plane::Xz => P3::new(0.0, 2.0, 0.0),
+                Plane::Yz => P3::new(3.0, 0.0, 0.0),
+            };
+            let pts = chord_points(start, &b, "t").unwrap();
+            assert!(pts.len() > 100, "{plane:?}");
+            assert!((pts.last().unwrap() - end).norm() < 1e-12, "{plane:?}");
+            for (k, p) in pts.iter().enumerate() {
+                let (q, w) = plane.split(p);
+                assert!(((q - centre).norm() - 5.0).abs() < 1e-9, "{plane:?} {p:?}");
+                let (_, w0) = plane.split(&start);
+                let (_, w1) = plane.split(&end);
+                let t = (k + 1) as f64 / pts.len() as f64;
+                assert!((w - (w0 + (w1 - w0) * t)).abs() < 1e-12, "{plane:?}");
+            }
+        }
+    }
 }

@@ -1,24 +1,60 @@
 //! A reader for multi-axis programs (X Y Z A B C), separate from the 3-axis reader so that reader
 //! keeps returning what it always did. It understands what 5- and 6-axis posts write: G0/G1,
-//! G20/G21, G90/G91, G93/G94 with F, G53 (machine coordinates for one block), G43/G43.4/G49 (tool
-//! length and tool-centre-point modes), work offsets, `M19 R` (oriented spindle stop), N, T, S, H,
-//! D words, `%`, a Fanuc `O` number, `( )` and `;` comments. Arcs, parameters, subroutines and
-//! any G code it does not know are refused with the line and the word: a program it cannot read
-//! exactly is not read at all.
+//! G2/G3 in G17/G18/G19 (I/J/K centres, incremental or with G90.1 absolute, R radii, P turns; the
+//! rotary axes standing still), G20/G21, G90/G91, G93/G94 with F, G53 (machine coordinates for
+//! one block), G43/G43.4/G49 (tool length and tool-centre-point modes), work offsets, `M19 R`
+//! (oriented spindle stop), N, T, S, H, D words, `%`, a Fanuc `O` number, `( )` and `;` comments.
+//! Parameters, subroutines and any G code it does not know are refused with the line and the
+//! word: a program it cannot read exactly is not read at all.
 
 use super::{Motion, Units};
 use crate::error::{Error, Location, Result};
+use crate::geom::{Arc2, P2, P3, Plane};
 
 /// Index of each address in [`AxisMove::pos`].
 pub const AXIS_LETTERS: [u8; 6] = [b'X', b'Y', b'Z', b'A', b'B', b'C'];
+
+/// The circle of a G2/G3 block: plane, centre (mm, in the plane's coordinates), direction and
+/// whole turns beyond the first (P − 1).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AxisArc {
+    /// G17, G18 or G19.
+    pub plane: Plane,
+    /// Centre in the plane's (u, v) coordinates (mm).
+    pub centre: P2,
+    /// G3.
+    pub ccw: bool,
+    /// Extra full turns.
+    pub turns: u32,
+}
+
+impl AxisArc {
+    /// The arc in plane coordinates from `a` to `b` (X, Y, Z), turns included, and the normal
+    /// coordinates at both ends.
+    pub fn in_plane(&self, a: &P3, b: &P3) -> (Arc2, f64, f64) {
+        let (pa, wa) = self.plane.split(a);
+        let (pb, wb) = self.plane.split(b);
+        let mut arc = Arc2::from_centre(self.centre, &pa, &pb, self.ccw, true);
+        arc.sweep += arc.sweep.signum() * std::f64::consts::TAU * f64::from(self.turns);
+        (arc, wa, wb)
+    }
+
+    /// X, Y, Z at fraction `t` of the move from `a` to `b` (the normal coordinate linear).
+    pub fn point(&self, a: &P3, b: &P3, t: f64) -> P3 {
+        let (arc, wa, wb) = self.in_plane(a, b);
+        self.plane.join(&arc.point_at_fraction(t), wa + (wb - wa) * t)
+    }
+}
 
 /// One motion block of a multi-axis program.
 #[derive(Clone, Debug, PartialEq)]
 pub struct AxisMove {
     /// 1-based source line.
     pub line: u32,
-    /// G0 or G1.
+    /// G0, G1, G2 or G3.
     pub motion: Motion,
+    /// The circle of a G2/G3 block.
+    pub arc: Option<AxisArc>,
     /// X, Y, Z (mm) and A, B, C (degrees) after the block, as programmed (work coordinates, or
     /// machine coordinates when `machine_coords`).
     pub pos: [f64; 6],
@@ -140,6 +176,8 @@ pub fn read_axes(name: &str, text: &str) -> Result<AxisProgram> {
     let mut units = Units::Mm;
     let (mut relative, mut inverse_time, mut tcp) = (false, false, false);
     let mut motion: Option<Motion> = None;
+    let mut plane = Plane::Xy;
+    let mut absolute_centres = false;
     let mut feed: Option<f64> = None;
     let mut pos = [0.0; 6];
     let mut known = [false; 6];
@@ -179,21 +217,22 @@ pub fn read_axes(name: &str, text: &str) -> Result<AxisProgram> {
             let code = (w.value * 10.0).round() as i64;
             match w.letter {
                 b'G' => match code {
-                    0 | 10 => {
+                    0 | 10 | 20 | 30 => {
                         if block_motion.is_some() {
                             return Err(err(name, line_no, w.start, &word_text(w), "two motion codes in one block"));
                         }
-                        block_motion = Some(if code == 0 { Motion::Rapid } else { Motion::Line });
+                        block_motion = Some(match code {
+                            0 => Motion::Rapid,
+                            10 => Motion::Line,
+                            20 => Motion::Cw,
+                            _ => Motion::Ccw,
+                        });
                     }
-                    20 | 30 => {
-                        return Err(err(
-                            name,
-                            line_no,
-                            w.start,
-                            &word_text(w),
-                            "arcs are not read by the multi-axis reader",
-                        ));
-                    }
+                    170 => plane = Plane::Xy,
+                    180 => plane = Plane::Xz,
+                    190 => plane = Plane::Yz,
+                    901 => absolute_centres = true,
+                    911 => absolute_centres = false,
                     200 => units = Units::Inch,
                     210 => units = Units::Mm,
                     900 => relative = false,
@@ -204,9 +243,9 @@ pub fn read_axes(name: &str, text: &str) -> Result<AxisProgram> {
                     434 => tcp = true,
                     490 => tcp = false,
                     800 => motion = None,
-                    // Planes, cutter compensation off, tool length offset, exact stop and path
-                    // modes, arc centre modes, work offsets: nothing that moves or scales a position.
-                    170 | 180 | 190 | 400 | 430 | 610 | 611 | 640 | 901 | 911 | 150 | 690 | 540..=590 | 591..=593 => {}
+                    // Cutter compensation off, tool length offset, exact stop and path modes, work
+                    // offsets: nothing that moves or scales a position.
+                    400 | 430 | 610 | 611 | 640 | 150 | 690 | 540..=590 | 591..=593 => {}
                     _ => {
                         return Err(err(
                             name,
@@ -218,15 +257,6 @@ pub fn read_axes(name: &str, text: &str) -> Result<AxisProgram> {
                     }
                 },
                 b'M' if code == 190 => m19 = true,
-                b'I' | b'J' | b'K' => {
-                    return Err(err(
-                        name,
-                        line_no,
-                        w.start,
-                        &word_text(w),
-                        "arcs are not read by the multi-axis reader",
-                    ));
-                }
                 b'U' | b'V' | b'W' | b'E' => {
                     return Err(err(name, line_no, w.start, &word_text(w), "axis not read by the multi-axis reader"));
                 }
@@ -237,8 +267,6 @@ pub fn read_axes(name: &str, text: &str) -> Result<AxisProgram> {
             let r = ws.iter().find(|w| w.letter == b'R').map_or(0.0, |w| w.value);
             orient = Some(r);
             prog.orients += 1;
-        } else if let Some(w) = ws.iter().find(|w| w.letter == b'R') {
-            return Err(err(name, line_no, w.start, &word_text(w), "R is read only with M19"));
         }
         if let Some(w) = ws.iter().find(|w| w.letter == b'F') {
             if w.value <= 0.0 {
@@ -250,7 +278,10 @@ pub fn read_axes(name: &str, text: &str) -> Result<AxisProgram> {
             motion = Some(m);
         }
         let named: [bool; 6] = std::array::from_fn(|k| ws.iter().any(|w| w.letter == AXIS_LETTERS[k]));
-        if !named.iter().any(|n| *n) {
+        // A full circle names no axis: its centre words make it a move.
+        let circle =
+            motion.is_some_and(Motion::is_arc) && ws.iter().any(|w| matches!(w.letter, b'I' | b'J' | b'K' | b'R'));
+        if !named.iter().any(|n| *n) && !circle {
             if g53 {
                 return Err(err(name, line_no, 0, line, "G53 without coordinates"));
             }
@@ -295,6 +326,14 @@ pub fn read_axes(name: &str, text: &str) -> Result<AxisProgram> {
             }
         }
         let n = ws.iter().find(|w| w.letter == b'N').map(|w| w.value as u64);
+        let arc = if m.is_arc() {
+            Some(arc_of(name, line_no, line, &ws, m, plane, absolute_centres, units, &pos, &known, &block_pos)?)
+        } else {
+            if let Some(w) = ws.iter().find(|w| matches!(w.letter, b'I' | b'J' | b'K') || (w.letter == b'R' && !m19)) {
+                return Err(err(name, line_no, w.start, &word_text(w), "I, J, K and R belong to arcs (G2, G3)"));
+            }
+            None
+        };
         let mut block_known = known;
         for k in 0..6 {
             block_known[k] |= named[k];
@@ -302,6 +341,7 @@ pub fn read_axes(name: &str, text: &str) -> Result<AxisProgram> {
         prog.moves.push(AxisMove {
             line: line_no,
             motion: m,
+            arc,
             pos: block_pos,
             known: block_known,
             named,
@@ -330,6 +370,98 @@ pub fn read_axes(name: &str, text: &str) -> Result<AxisProgram> {
     Ok(prog)
 }
 
+/// The circle of a G2/G3 block: from the centre words I/J/K (offsets from the start, or absolute
+/// with G90.1) or the radius R (positive: at most half a turn; negative: more), and P turns.
+#[allow(clippy::too_many_arguments)]
+fn arc_of(
+    name: &str,
+    line_no: u32,
+    line: &str,
+    ws: &[Word],
+    m: Motion,
+    plane: Plane,
+    absolute_centres: bool,
+    units: Units,
+    pos: &[f64; 6],
+    known: &[bool; 6],
+    end: &[f64; 6],
+) -> Result<AxisArc> {
+    let word_text = |w: &Word| line[w.start..w.end].to_string();
+    let whole = |message: &str| err(name, line_no, 0, line, message);
+    if !known[..3].iter().all(|k| *k) {
+        return Err(whole("an arc from an unknown position"));
+    }
+    if let Some(w) = ws.iter().find(|w| matches!(w.letter, b'A' | b'B' | b'C')) {
+        return Err(err(name, line_no, w.start, &word_text(w), "an arc with a rotary axis moving is not read"));
+    }
+    let [iu, iv, iw] = plane.axes();
+    let letter = |k: usize| b"IJK"[k];
+    if let Some(w) = ws.iter().find(|w| w.letter == letter(iw)) {
+        return Err(err(
+            name,
+            line_no,
+            w.start,
+            &word_text(w),
+            "a centre word across the arc's plane (G17: I J, G18: I K, G19: J K)",
+        ));
+    }
+    let start = P3::new(pos[0], pos[1], pos[2]);
+    let stop = P3::new(end[0], end[1], end[2]);
+    let (a, _) = plane.split(&start);
+    let (b, _) = plane.split(&stop);
+    let ccw = m == Motion::Ccw;
+    let turns = match ws.iter().find(|w| w.letter == b'P') {
+        None => 0,
+        Some(w) if w.value >= 1.0 && w.value.fract() == 0.0 => w.value as u32 - 1,
+        Some(w) => {
+            return Err(err(name, line_no, w.start, &word_text(w), "P of an arc is a whole number of turns ≥ 1"));
+        }
+    };
+    let centre_words: Vec<&Word> = ws.iter().filter(|w| w.letter == letter(iu) || w.letter == letter(iv)).collect();
+    let radius = ws.iter().find(|w| w.letter == b'R');
+    let centre = match (radius, centre_words.is_empty()) {
+        (Some(w), true) => {
+            let r = w.value * units.mm();
+            let d = (b - a).norm();
+            if d == 0.0 || d > 2.0 * r.abs() * (1.0 + 1e-9) {
+                return Err(err(
+                    name,
+                    line_no,
+                    w.start,
+                    &word_text(w),
+                    "no arc of this radius joins the start and the end",
+                ));
+            }
+            let h = (r * r - 0.25 * d * d).max(0.0).sqrt();
+            let mid = P2::from((a.coords + b.coords) * 0.5);
+            let left = crate::geom::V2::new(a.y - b.y, b.x - a.x) / d;
+            // The centre on the side that makes the arc the shorter one for R > 0.
+            let side = if ccw == (r > 0.0) { 1.0 } else { -1.0 };
+            mid + left * (side * h)
+        }
+        (Some(w), false) => {
+            return Err(err(name, line_no, w.start, &word_text(w), "an arc has a radius R or centre words, not both"));
+        }
+        (None, _) => {
+            let offset = |k: usize| ws.iter().find(|w| w.letter == letter(k)).map_or(0.0, |w| w.value * units.mm());
+            let (ou, ov) = (offset(iu), offset(iv));
+            if centre_words.is_empty() {
+                return Err(whole("an arc needs its centre (I, J, K) or radius (R)"));
+            }
+            if absolute_centres { P2::new(ou, ov) } else { P2::new(a.x + ou, a.y + ov) }
+        }
+    };
+    let (r0, r1) = ((a - centre).norm(), (b - centre).norm());
+    if r0 == 0.0 || (r0 - r1).abs() > ARC_RADIUS_SLACK.max(r0 * 1e-6) {
+        return Err(whole(&format!("the arc's ends are {r0:.6} and {r1:.6} mm from its centre: not one circle")));
+    }
+    Ok(AxisArc { plane, centre, ccw, turns })
+}
+
+/// How far apart the start and end radii of an arc read may be (mm): the rounding of the words
+/// of a written program, with margin.
+pub const ARC_RADIUS_SLACK: f64 = 0.002;
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -355,10 +487,46 @@ mod tests {
         assert!(e.to_string().contains("unknown position"), "{e}");
     }
 
+    /// Arcs in each plane by centre words, absolute centres, radii of both signs and turns: the
+    /// centre and the points along them as RS274 defines them.
+    #[test]
+    fn reads_arcs() {
+        let text = "G0 X10 Y0 Z0\nG3 X0 Y10 I-10 J0 F100\nG2 X10 Y0 R-10\nG2 I-10 P2 Z-3\n\
+                    G18 G3 X0 Z7 I-10 K0\nG90.1 G19 G2 Y2 Z5 J0 K5\n";
+        let p = read_axes("t.nc", text).unwrap();
+        let arcs: Vec<AxisArc> = p.moves.iter().filter_map(|m| m.arc).collect();
+        assert_eq!(arcs.len(), 5);
+        let at = |k: usize| {
+            let (a, b) = (&p.moves[k], &p.moves[k + 1]);
+            let p3 = |m: &AxisMove| P3::new(m.pos[0], m.pos[1], m.pos[2]);
+            (p3(a), p3(b), b.arc.unwrap())
+        };
+        // G3 a quarter: through (10/√2, 10/√2).
+        let (a, b, arc) = at(0);
+        assert!((arc.point(&a, &b, 0.5) - P3::new(50f64.sqrt(), 50f64.sqrt(), 0.0)).norm() < 1e-12);
+        // G2 R−10 back to (10, 0): the long way, three quarters about (10, 10).
+        let (a, b, arc) = at(1);
+        assert!((arc.centre - P2::new(10.0, 10.0)).norm() < 1e-12, "{arc:?}");
+        assert!((arc.in_plane(&a, &b).0.sweep + 1.5 * std::f64::consts::PI).abs() < 1e-12);
+        // A full circle twice down 3 mm: half-way is the start, 1.5 mm down.
+        let (a, b, arc) = at(2);
+        assert_eq!(arc.turns, 1);
+        assert!((arc.point(&a, &b, 0.5) - P3::new(10.0, 0.0, -1.5)).norm() < 1e-9);
+        // G18: (u, v) = (z, x); from (10, 0, −3) about (z, x) = (−3, 0) to (0, 0, 7).
+        let (_, _, arc) = at(3);
+        assert_eq!((arc.plane, arc.centre), (Plane::Xz, P2::new(-3.0, 0.0)));
+        let (_, _, arc) = at(4);
+        assert_eq!((arc.plane, arc.centre, arc.ccw), (Plane::Yz, P2::new(0.0, 5.0), false));
+    }
+
     #[test]
     fn refuses_what_it_cannot_read_exactly() {
-        let e = read_axes("t.nc", "G0 X0 Y0\nG2 X1 Y1 I1 J0\n").unwrap_err();
-        assert_eq!(e.to_string(), "t.nc:2:1 (G2): arcs are not read by the multi-axis reader");
+        let e = read_axes("t.nc", "G0 X0 Y0 Z0\nG2 X1 Y1 I2 J0 F100\n").unwrap_err();
+        assert!(e.to_string().contains("not one circle"), "{e}");
+        let e = read_axes("t.nc", "G0 X0 Y0 Z0\nG2 X1 Y1 A3 I1 F100\n").unwrap_err();
+        assert!(e.to_string().contains("rotary axis moving"), "{e}");
+        let e = read_axes("t.nc", "G0 X0 Y0 Z0\nG1 X1 Y1 I1 F100\n").unwrap_err();
+        assert!(e.to_string().contains("belong to arcs"), "{e}");
         let e = read_axes("t.nc", "G93\nG1 X1 F10\nG1 X2\n").unwrap_err();
         assert!(e.to_string().contains("needs its own F word"), "{e}");
         let e = read_axes("t.nc", "X1\n").unwrap_err();

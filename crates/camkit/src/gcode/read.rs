@@ -77,6 +77,17 @@ fn parse_number(line: &[u8], mut i: usize) -> Option<(f64, usize, u32)> {
     Some((if neg { -value } else { value }, i, decimals))
 }
 
+/// True for a line that is only a program number: `O` and digits, then nothing but spaces and
+/// comments (the first line of a Fanuc program after `%`).
+fn program_number(line: &[u8]) -> bool {
+    let s = String::from_utf8_lossy(line);
+    let t = s.trim_start();
+    let Some(rest) = t.strip_prefix(['O', 'o']) else { return false };
+    let digits = rest.bytes().take_while(u8::is_ascii_digit).count();
+    let tail = rest[digits..].trim();
+    digits > 0 && (tail.is_empty() || (tail.starts_with('(') && tail.ends_with(')') && tail.matches('(').count() == 1))
+}
+
 /// The M code of a block that starts with an M word (after an optional N word).
 fn m_led(line: &[u8]) -> Option<u32> {
     let mut i = 0;
@@ -388,6 +399,16 @@ impl Reader<'_> {
                 remark_only,
             }));
         }
+        if program_number(line) {
+            // A Fanuc program number (`O1234`, maybe with a comment): not a block to interpret.
+            return Ok(Block::Other(OtherBlock {
+                line: line_no,
+                span,
+                modes: self.modes,
+                motion_word: false,
+                remark_only: false,
+            }));
+        }
         if let Some(code) = m_led(line) {
             // An M block (Marlin's M84 X Y E, M117 free text...): its parameters are not
             // coordinates and need not be numbers. Only the extruder mode is read from it.
@@ -612,6 +633,24 @@ mod tests {
         assert_eq!(m[1].end, P3::new(50.8, 50.8, 0.0));
         assert_eq!(m[2].end, P3::new(50.8, 3.0, 0.0));
         assert!(!m[2].plain, "a commented move is written back verbatim");
+    }
+
+    /// What post-6axis writes in the Fanuc dialect reads: `%`, the program number, N words, G53
+    /// (the position after it unknown), G43.4, G93 with inverse-time F, M19 R.
+    #[test]
+    fn reads_a_fanuc_program_the_post_writes() {
+        let p = parse(
+            "%\nO2002 (Paper 002 machine)\nN10 G21 G17 G90 G94\nN20 G53 G0 Z0\nN30 T1 M6\nN40 G43.4 H1\n\
+             N50 G0 X1 Y2 Z3 A4 C5\nN60 M19 R45\nN70 G93 G1 X2 F120.5\nN80 G94 G1 X3 F300\nN90 M30\n%\n",
+        )
+        .unwrap();
+        let m = moves(&p);
+        assert_eq!(m.len(), 3);
+        assert!(!m[0].start_known && !m[0].plain, "{:?}", m[0]);
+        assert_eq!(m[0].end, P3::new(1.0, 2.0, 3.0));
+        assert!(m[1].modes.inverse_time && m[1].start_known);
+        assert_eq!(m[2].modes.feed, Some(300.0));
+        assert!(parse("O12 G0 X1\n").is_err(), "an O word with more on its line is an o-code");
     }
 
     #[test]

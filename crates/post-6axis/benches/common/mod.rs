@@ -21,7 +21,16 @@ pub fn rows(n: usize) -> Vec<Cl> {
             let t = (-5.0f64).to_radians();
             let axis = (normal * t.cos() + feed * t.sin()).normalize();
             let s = edge_angle(&axis, &(feed - axis * axis.dot(&feed)).normalize());
-            Cl { tip: p, axis, s: Some(s), feed: Some(1000.0), rapid: k == 0, reorient: k == 0, line: i as u64 + 2 }
+            Cl {
+                tip: p,
+                axis,
+                s: Some(s),
+                feed: Some(1000.0),
+                rapid: k == 0,
+                reorient: k == 0,
+                line: i as u64 + 2,
+                arc: None,
+            }
         })
         .collect()
 }
