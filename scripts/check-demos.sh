@@ -31,7 +31,7 @@ for prog in "${programs[@]}"; do
 import json, sys
 r = json.load(open(sys.argv[1]))
 bad = r["rapids_into_material"] != 0 or r["part_collisions"] != 0
-fmt = lambda v: "none" if v is None else f"{v:.4f} mm"
+fmt = lambda v: "none" if v is None else f"{v:.6f} mm"
 print(("FAILED " if bad else "") + f"collisions: {r['rapids_into_material']} rapids into material, "
       f"{r['part_collisions']} moves too near the part; smallest rapid clearance {fmt(r['smallest_rapid_clearance_mm'])}, "
       f"smallest feed clearance {fmt(r['smallest_feed_clearance_mm'])} ({r['part_checked']})")
