@@ -61,19 +61,21 @@ fn machine() -> String {
     data("post-6axis/three-axis.json").to_string_lossy().into_owned()
 }
 
-/// One motion block read from the program text: G0 or not, where it starts and ends, its line.
+/// One motion block read from the program text: G0 or not, where it starts and ends, the centre
+/// and direction of an XY arc (G17 G2/G3 with I J), its line.
 #[derive(Clone, Copy, Debug)]
 struct Block {
     rapid: bool,
     from: [f64; 3],
     to: [f64; 3],
+    arc: Option<([f64; 2], bool)>,
     line: usize,
 }
 
-/// The motion blocks of a 3-axis program of G0/G1 blocks (modal words carried), after the first
-/// position is known in every axis.
+/// The motion blocks of a 3-axis program of G0/G1/G2/G3 blocks in G17 (modal words carried),
+/// after the first position is known in every axis.
 fn blocks(nc: &str) -> Vec<Block> {
-    let (mut pos, mut known, mut rapid) = ([0.0f64; 3], [false; 3], true);
+    let (mut pos, mut known, mut motion) = ([0.0f64; 3], [false; 3], 0);
     let mut out = Vec::new();
     for (i, line) in nc.lines().enumerate() {
         let words: Vec<&str> = line.split_whitespace().collect();
@@ -81,33 +83,35 @@ fn blocks(nc: &str) -> Vec<Block> {
             known = [false; 3];
             continue;
         }
+        assert!(!words.contains(&"G18") && !words.contains(&"G19"), "XY arcs only here");
         for w in &words {
             match *w {
-                "G0" => rapid = true,
-                "G1" => rapid = false,
+                "G0" => motion = 0,
+                "G1" => motion = 1,
+                "G2" => motion = 2,
+                "G3" => motion = 3,
                 _ => {}
             }
         }
+        let word =
+            |l: u8| words.iter().find(|w| w.as_bytes()[0] == l).map(|w| w[1..].parse::<f64>().expect("a number"));
         let mut to = pos;
-        let mut moved = false;
-        for w in &words {
-            let k = match w.as_bytes()[0] {
-                b'X' => 0,
-                b'Y' => 1,
-                b'Z' => 2,
-                _ => continue,
-            };
-            to[k] = w[1..].parse().expect("a number");
-            moved = true;
+        for (k, l) in [b'X', b'Y', b'Z'].into_iter().enumerate() {
+            if let Some(v) = word(l) {
+                to[k] = v;
+            }
         }
-        if !moved {
+        let (ci, cj) = (word(b'I'), word(b'J'));
+        let moved = to != pos || ci.is_some() || cj.is_some();
+        if !moved || words.iter().any(|w| w.starts_with('M') || w.starts_with('T')) {
             continue;
         }
+        let arc = (motion >= 2).then(|| ([pos[0] + ci.unwrap_or(0.0), pos[1] + cj.unwrap_or(0.0)], motion == 3));
         if known.iter().all(|k| *k) {
-            out.push(Block { rapid, from: pos, to, line: i + 1 });
+            out.push(Block { rapid: motion == 0, from: pos, to, arc, line: i + 1 });
         }
-        for (k, w) in ["X", "Y", "Z"].iter().enumerate() {
-            known[k] |= words.iter().any(|x| x.starts_with(w));
+        for (k, l) in [b'X', b'Y', b'Z'].into_iter().enumerate() {
+            known[k] |= word(l).is_some();
         }
         pos = to;
     }
@@ -122,11 +126,33 @@ fn seg_dist(x: f64, y: f64, a: &[f64; 3], b: &[f64; 3]) -> f64 {
     ((x - a[0] - t * dx).powi(2) + (y - a[1] - t * dy).powi(2)).sqrt()
 }
 
+/// Distance from (x, y) to the XY path of a block: its segment, or its arc (the ends if the
+/// point's direction from the centre is outside the sweep).
+fn block_dist(x: f64, y: f64, b: &Block) -> f64 {
+    let Some((c, ccw)) = b.arc else { return seg_dist(x, y, &b.from, &b.to) };
+    let ang = |p: [f64; 2]| (p[1] - c[1]).atan2(p[0] - c[0]);
+    let (a0, a1, ap) = (ang([b.from[0], b.from[1]]), ang([b.to[0], b.to[1]]), ang([x, y]));
+    let tau = std::f64::consts::TAU;
+    let (sweep, along) = if ccw {
+        ((a1 - a0).rem_euclid(tau), (ap - a0).rem_euclid(tau))
+    } else {
+        ((a0 - a1).rem_euclid(tau), (a0 - ap).rem_euclid(tau))
+    };
+    let sweep = if sweep == 0.0 { tau } else { sweep };
+    let r = (b.from[0] - c[0]).hypot(b.from[1] - c[1]);
+    if along <= sweep {
+        ((x - c[0]).hypot(y - c[1]) - r).abs()
+    } else {
+        (x - b.from[0]).hypot(y - b.from[1]).min((x - b.to[0]).hypot(y - b.to[1]))
+    }
+}
+
 /// Every G0 of the program that is unsafe, with why: a rapid that moves sideways below the stock
-/// top plus the approach; a rapid below the top within R of the walls or the island (or inside
-/// it); a descent that ends less than the approach above the material under the tool (the stock
-/// less the feed moves before it, over a polar grid of the footprint).
-fn unsafe_rapids(nc: &str) -> Vec<(usize, String)> {
+/// top plus the approach; a rapid below the top whose end comes nearer than R to the part
+/// (`part`: the signed distance from (x, y) to the part's walls and islands, positive where the
+/// tool may be); a descent that ends less than the approach above the material under the tool
+/// (the stock less the feed moves before it, over a polar grid of the footprint).
+fn unsafe_rapids_in(nc: &str, part: &dyn Fn(f64, f64) -> f64) -> Vec<(usize, String)> {
     let bs = blocks(nc);
     let mut bad = Vec::new();
     for (i, b) in bs.iter().enumerate().filter(|(_, b)| b.rapid) {
@@ -137,15 +163,17 @@ fn unsafe_rapids(nc: &str) -> Vec<(usize, String)> {
             why.push(format!("sideways at z {low}"));
         }
         if low < 0.0 {
-            // The rectangle's walls are convex: the nearest point of a segment is an end.
-            let walls = [b.from, b.to]
-                .iter()
-                .map(|p| p[0].min(100.0 - p[0]).min(p[1]).min(60.0 - p[1]))
+            // Along the rapid every 0.01 mm (a vertical one is a point).
+            let n = ((b.to[0] - b.from[0]).hypot(b.to[1] - b.from[1]) / 0.01).ceil().max(1.0) as usize;
+            let d = (0..=n)
+                .map(|k| {
+                    let t = k as f64 / n as f64;
+                    part(b.from[0] + (b.to[0] - b.from[0]) * t, b.from[1] + (b.to[1] - b.from[1]) * t)
+                })
                 .fold(f64::INFINITY, f64::min)
                 - R;
-            let island = seg_dist(ISLAND.0, ISLAND.1, &b.from, &b.to) - ISLAND.2 - R;
-            if island.min(walls) < -1e-6 {
-                why.push(format!("{:.4} mm into the walls or the island", -island.min(walls)));
+            if d < -1e-4 {
+                why.push(format!("{:.4} mm into the walls or an island", -d));
             }
         }
         if !why.is_empty() {
@@ -153,19 +181,17 @@ fn unsafe_rapids(nc: &str) -> Vec<(usize, String)> {
             continue;
         }
         if b.to[2] < b.from[2] {
+            let (x0, y0) = (b.to[0], b.to[1]);
+            let near: Vec<&Block> = bs[..i].iter().filter(|f| !f.rapid && block_dist(x0, y0, f) <= 2.0 * R).collect();
             let top = |x: f64, y: f64| {
-                bs[..i]
-                    .iter()
-                    .filter(|f| !f.rapid && seg_dist(x, y, &f.from, &f.to) <= R)
-                    .map(|f| f.from[2].min(f.to[2]))
-                    .fold(0.0f64, f64::min)
+                near.iter().filter(|f| block_dist(x, y, f) <= R).map(|f| f.from[2].min(f.to[2])).fold(0.0f64, f64::min)
             };
             let mut highest = f64::NEG_INFINITY;
-            for ring in 0..=16 {
-                let rho = (R - 0.011) * ring as f64 / 16.0;
-                for k in 0..64 {
-                    let a = std::f64::consts::TAU * k as f64 / 64.0;
-                    highest = highest.max(top(b.to[0] + rho * a.cos(), b.to[1] + rho * a.sin()));
+            for ring in 0..=8 {
+                let rho = (R - 0.011) * ring as f64 / 8.0;
+                for k in 0..48 {
+                    let a = std::f64::consts::TAU * k as f64 / 48.0;
+                    highest = highest.max(top(x0 + rho * a.cos(), y0 + rho * a.sin()));
                 }
             }
             if b.to[2] < highest + APPROACH - 0.01 - 1e-9 {
@@ -174,6 +200,22 @@ fn unsafe_rapids(nc: &str) -> Vec<(usize, String)> {
         }
     }
     bad
+}
+
+/// [`unsafe_rapids_in`] for the 100 × 60 pocket with its round island.
+fn unsafe_rapids(nc: &str) -> Vec<(usize, String)> {
+    unsafe_rapids_in(nc, &|x, y| {
+        let island = (x - ISLAND.0).hypot(y - ISLAND.1) - ISLAND.2;
+        let walls = x.min(100.0 - x).min(y).min(60.0 - y);
+        island.min(walls)
+    })
+}
+
+/// Signed distance from (x, y) to a rectangle centred at (cx, cy), half sides (hx, hy), corners
+/// rounded by r: positive outside.
+fn rounded_box(x: f64, y: f64, (cx, cy): (f64, f64), (hx, hy): (f64, f64), r: f64) -> f64 {
+    let (qx, qy) = ((x - cx).abs() - (hx - r), (y - cy).abs() - (hy - r));
+    qx.max(0.0).hypot(qy.max(0.0)) + qx.max(qy).min(0.0) - r
 }
 
 fn report(w: &Work, name: &str) -> serde_json::Value {
@@ -202,7 +244,7 @@ fn an_island_pocket_posted_with_a_setup_has_no_unsafe_rapid() {
     let naive = naive.ok();
     let found = unsafe_rapids(&naive);
     assert!(found.len() >= 7, "{found:?}");
-    assert!(found.iter().any(|(_, why)| why.contains("into the walls or the island")), "{found:?}");
+    assert!(found.iter().any(|(_, why)| why.contains("into the walls or an island")), "{found:?}");
 }
 
 /// The post's own check names the first unsafe G0 of a program by its NC line, and writes its
@@ -370,5 +412,51 @@ fn random_pocket_jobs_link_safely() {
             (Some(0), Some(0)),
             "case {case}"
         );
+    }
+}
+
+/// The DXF pocket with two islands (data/post-6axis/pocket-islands.dxf) roughed by medial-trochoid
+/// for a φ8 flat end mill in 3 layers (the layers from the setup), posted with the setup: every
+/// G0 safe by the independent check against the islands' and the walls' exact shapes, the stock
+/// top and the material the earlier cuts left; the post's check agrees.
+#[test]
+fn the_dxf_pocket_with_two_islands_posts_with_safe_rapids() {
+    let w = Work::new();
+    let setup = data("jobs/pocket-islands.json");
+    let setup = setup.to_string_lossy();
+    let dxf = data("post-6axis/pocket-islands.dxf");
+    let args = [dxf.to_str().unwrap(), "--setup", &setup, "--layer-depth", "4", "--sample", "2", "--decimals", "4"];
+    w.run("medial-trochoid", &[&args[..], &["--report", "mt.json", "-o", "rough.csv"]].concat(), b"").ok();
+    let mt: serde_json::Value = serde_json::from_str(&w.read("mt.json")).unwrap();
+    assert_eq!((mt["layers"].as_u64(), mt["islands"].as_u64()), (Some(3), Some(2)), "{mt}");
+    w.run(
+        BIN,
+        &["rough.csv", "--machine", &machine(), "--setup", &setup, "--report", "r.json", "-o", "rough.ngc"],
+        b"",
+    )
+    .ok();
+    let nc = w.read("rough.ngc");
+    let part = |x: f64, y: f64| {
+        let walls = -rounded_box(x, y, (60.0, 40.0), (60.0, 40.0), 10.0);
+        let round = (x - 35.0).hypot(y - 40.0) - 8.0;
+        let square = rounded_box(x, y, (85.0, 40.0), (10.0, 8.0), 3.0);
+        walls.min(round).min(square)
+    };
+    let bad = unsafe_rapids_in(&nc, &part);
+    assert_eq!(bad, vec![], "unsafe rapids");
+    let rapids = blocks(&nc).iter().filter(|b| b.rapid && b.from[2].min(b.to[2]) < 0.0).count();
+    assert!(rapids > 50, "{rapids} rapids below the stock top checked");
+    let r = report(&w, "r.json");
+    assert_eq!((r["rapids_into_material"].as_u64(), r["part_collisions"].as_u64()), (Some(0), Some(0)), "{r}");
+    // Every feed move keeps R from the islands and the walls (to the rounding of 4 decimals).
+    for b in blocks(&nc).iter().filter(|b| !b.rapid && b.to[2] < 0.0) {
+        for t in 0..=4 {
+            let t = t as f64 / 4.0;
+            let (x, y) = match b.arc {
+                None => (b.from[0] + (b.to[0] - b.from[0]) * t, b.from[1] + (b.to[1] - b.from[1]) * t),
+                Some(_) => (b.to[0], b.to[1]),
+            };
+            assert!(part(x, y) >= R - 1e-3, "line {}: ({x}, {y}) is {} from the part", b.line, part(x, y));
+        }
     }
 }
