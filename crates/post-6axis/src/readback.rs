@@ -6,6 +6,7 @@
 use crate::plan::{Cl, point_segment, slerp, vector_arc};
 use camkit::doc::machine::{Machine, SpindleMode};
 use camkit::gcode::{AXIS_LETTERS, AxisArc, AxisProgram, Motion};
+use camkit::geom::arc::PreparedArc;
 use camkit::geom::{P2, P3, Plane, V3};
 use camkit::kinematics::{Chain, Joints, principal_deg};
 use camkit::table::{Col, Move, Row, Schema, Table};
@@ -119,12 +120,48 @@ pub fn samples_of(a: &NcPose, b: &NcPose, base: usize) -> usize {
     }
 }
 
-/// Distance from `p` to the CL path between rows `a` and `b`: the segment, or the arc `b`
-/// arrives along.
-pub fn cl_distance(p: &P3, a: &Cl, b: &Cl) -> f64 {
-    match &b.arc {
-        Some(arc) => arc.distance(p, &a.tip, &b.tip),
-        None => point_segment(p, &a.tip, &b.tip),
+/// The CL path between two rows, made ready for many distances: the segment, the planar arc the
+/// second row arrives along (prepared in its plane), or a helix.
+#[derive(Clone, Copy, Debug)]
+enum ClPath {
+    Line(P3, P3),
+    Planar(camkit::geom::Plane, PreparedArc, f64),
+    Helix(crate::plan::ClArc, P3, P3, PreparedArc),
+}
+
+impl ClPath {
+    fn of(a: &Cl, b: &Cl) -> ClPath {
+        match &b.arc {
+            None => ClPath::Line(a.tip, b.tip),
+            Some(arc) => {
+                let (plane_arc, wa, wb) = arc.in_plane(&a.tip, &b.tip);
+                if wa == wb {
+                    ClPath::Planar(arc.plane, PreparedArc::new(&plane_arc), wa)
+                } else {
+                    ClPath::Helix(*arc, a.tip, b.tip, PreparedArc::new(&plane_arc))
+                }
+            }
+        }
+    }
+
+    /// Distance from `p` (exact; a helix's within 1e-9).
+    fn distance(&self, p: &P3) -> f64 {
+        match self {
+            ClPath::Line(a, b) => point_segment(p, a, b),
+            ClPath::Planar(plane, arc, w) => {
+                let (q, pw) = plane.split(p);
+                arc.distance(&q).hypot(pw - w)
+            }
+            ClPath::Helix(arc, a, b, _) => arc.distance(p, a, b),
+        }
+    }
+
+    /// A lower bound of [`ClPath::distance`], cheap for a helix: the distance in its plane.
+    fn lower_bound(&self, p: &P3) -> f64 {
+        match self {
+            ClPath::Helix(arc, _, _, prepared) => prepared.distance(&arc.plane.split(p).0),
+            _ => self.distance(p),
+        }
     }
 }
 
@@ -170,19 +207,25 @@ pub struct Deviation {
 }
 
 /// Index of the segment of `segs` (pairs of CL indices) nearest `p`, searched near `hint` first.
-fn nearest(p: &P3, cl: &[Cl], segs: &[(usize, usize)], hint: usize, far: f64) -> (usize, f64) {
+fn nearest(p: &P3, paths: &[ClPath], segs: &[(usize, usize)], hint: usize, far: f64) -> (usize, f64) {
     let lo = hint.saturating_sub(2);
     let hi = (hint + 16).min(segs.len());
     let mut best = (hint.min(segs.len().saturating_sub(1)), f64::INFINITY);
-    for (k, &(a, b)) in segs.iter().enumerate().take(hi).skip(lo) {
-        let d = cl_distance(p, &cl[a], &cl[b]);
+    for (k, path) in paths.iter().enumerate().take(hi).skip(lo) {
+        if path.lower_bound(p) >= best.1 {
+            continue;
+        }
+        let d = path.distance(p);
         if d < best.1 {
             best = (k, d);
         }
     }
     if best.1 > far {
-        for (k, &(a, b)) in segs.iter().enumerate() {
-            let d = cl_distance(p, &cl[a], &cl[b]);
+        for (k, path) in paths.iter().enumerate() {
+            if path.lower_bound(p) >= best.1 {
+                continue;
+            }
+            let d = path.distance(p);
             if d < best.1 {
                 best = (k, d);
             }
@@ -215,6 +258,7 @@ pub const CHUNK: usize = 8192;
 pub fn verify(cl: &[Cl], poses: &[Option<NcPose>], r: &Reading, samples_per_block: usize, tol: f64) -> Deviation {
     let far = tol;
     let segs: Vec<(usize, usize)> = (1..cl.len()).filter(|&i| !cl[i].rapid).map(|i| (i - 1, i)).collect();
+    let paths: Vec<ClPath> = segs.par_iter().map(|&(a, b)| ClPath::of(&cl[a], &cl[b])).collect();
     // Feed blocks as (start, end) poses in program order; a G53 block or an unknown position
     // breaks the chain.
     let mut blocks: Vec<(&NcPose, &NcPose)> = Vec::with_capacity(poses.len());
@@ -236,7 +280,7 @@ pub fn verify(cl: &[Cl], poses: &[Option<NcPose>], r: &Reading, samples_per_bloc
         let parts: Vec<Deviation> = blocks
             .par_chunks(CHUNK)
             .enumerate()
-            .map(|(c, chunk)| check_blocks(cl, &segs, chunk, (c == 0).then_some(0), r, samples_per_block, far))
+            .map(|(c, chunk)| check_blocks(cl, &segs, &paths, chunk, (c == 0).then_some(0), r, samples_per_block, far))
             .collect();
         for p in parts {
             if p.tip > dev.tip {
@@ -333,7 +377,17 @@ fn nearest_on_path(p: &P3, path: &[P3], hint: Option<usize>, far: f64) -> (usize
 /// least angle to the axis arc there. A short segment that turns the axis with the tip (nearly)
 /// still, or a pass closing on its start, leaves the tip's nearest parameter undefined: every
 /// axis along the turn is then where the tool may be, as planning measures it.
-fn axis_deviation(tip: &P3, axis: &V3, cl: &[Cl], segs: &[(usize, usize)], seg: usize, d: f64, tol: f64) -> f64 {
+#[allow(clippy::too_many_arguments)]
+fn axis_deviation(
+    tip: &P3,
+    axis: &V3,
+    cl: &[Cl],
+    segs: &[(usize, usize)],
+    paths: &[ClPath],
+    seg: usize,
+    d: f64,
+    tol: f64,
+) -> f64 {
     let (i0, i1) = segs[seg];
     let at = |k: usize, dk: f64| {
         let (a, b) = segs[k];
@@ -347,8 +401,7 @@ fn axis_deviation(tip: &P3, axis: &V3, cl: &[Cl], segs: &[(usize, usize)], seg: 
     let neighbours =
         [seg.checked_sub(1).filter(|&k| segs[k].1 == i0), Some(seg + 1).filter(|&k| k < segs.len() && segs[k].0 == i1)];
     for k in neighbours.into_iter().flatten() {
-        let (a, b) = segs[k];
-        let dk = cl_distance(tip, &cl[a], &cl[b]);
+        let dk = paths[k].distance(tip);
         if dk <= tol {
             best = best.min(at(k, dk));
         }
@@ -358,9 +411,11 @@ fn axis_deviation(tip: &P3, axis: &V3, cl: &[Cl], segs: &[(usize, usize)], seg: 
 
 /// The block part of [`verify`] for one chunk of consecutive feed blocks, the nearest-segment
 /// search starting at `hint` (none: a full search).
+#[allow(clippy::too_many_arguments)]
 fn check_blocks(
     cl: &[Cl],
     segs: &[(usize, usize)],
+    paths: &[ClPath],
     blocks: &[(&NcPose, &NcPose)],
     mut hint: Option<usize>,
     r: &Reading,
@@ -377,8 +432,8 @@ fn check_blocks(
             let (tip, axis) = r.at(&q);
             // Without a hint (a chunk but the first), a full search (a negative `far`).
             let (seg, d) = match hint {
-                Some(h) => nearest(&tip, cl, segs, h, far),
-                None => nearest(&tip, cl, segs, 0, -1.0),
+                Some(h) => nearest(&tip, paths, segs, h, far),
+                None => nearest(&tip, paths, segs, 0, -1.0),
             };
             hint = Some(seg);
             dev.samples += 1;
@@ -386,7 +441,7 @@ fn check_blocks(
                 dev.tip = d;
                 dev.tip_line = b.line;
             }
-            let da = axis_deviation(&tip, &axis, cl, segs, seg, d, far).to_degrees();
+            let da = axis_deviation(&tip, &axis, cl, segs, paths, seg, d, far).to_degrees();
             let (i0, i1) = segs[seg];
             let u = param(&tip, &cl[i0].tip, &cl[i1].tip);
             if da > dev.axis_deg {

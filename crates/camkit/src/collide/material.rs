@@ -17,6 +17,7 @@ use crate::contour::Seg;
 use crate::doc::setup::Stock;
 use crate::doc::tool::{Tool, ToolKind};
 use crate::geom::P2;
+use crate::geom::arc::PreparedArc;
 
 /// The bottom of a rotating tool seen along a vertical axis: a flat of radius `radius − corner`
 /// and a torus of radius `corner` round it (flat end mill: corner 0; ball: corner = radius).
@@ -195,11 +196,12 @@ impl Material {
             return;
         }
         let nodes: Vec<(usize, P2)> = self.near(piece, r).collect();
+        let prepared = Prepared::of(piece);
         for (k, p) in nodes {
             if self.top[k] == f64::NEG_INFINITY {
                 continue;
             }
-            let low = lowest_pass(cutter, d, piece, z0, z1, &p);
+            let low = lowest_pass(cutter, d, &prepared, z0, z1, &p);
             if low < self.top[k] {
                 self.top[k] = low;
             }
@@ -318,20 +320,58 @@ fn under(piece: &Seg, p: &P2, radius: f64) -> Option<(f64, f64)> {
             (t0 <= t1).then_some((t0, t1))
         }
         Seg::Arc(arc) => {
-            if piece.distance_to(p) > radius {
+            let prepared = PreparedArc::new(arc);
+            if prepared.distance(p) > radius {
                 return None;
             }
-            // The fractions where the arc is within reach form at most two intervals: take the
-            // hull of the sampled fractions inside, widened by one sample step either side.
-            let n = 64;
-            let inside: Vec<usize> =
-                (0..=n).filter(|&k| (arc.point_at_fraction(k as f64 / n as f64) - p).norm() <= radius).collect();
-            match (inside.first(), inside.last()) {
-                (Some(&f), Some(&l)) => {
-                    Some(((f as f64 - 1.0).max(0.0) / n as f64, ((l as f64 + 1.0) / n as f64).min(1.0)))
-                }
-                _ => Some((0.0, 1.0)),
+            // The directions from the centre whose circle point is within reach of `p`: a window
+            // of half-width acos((d² + r² − R²) / 2rd) about the direction of `p`.
+            let v = p - arc.c;
+            let d = v.norm();
+            let k = if d > 0.0 { (d * d + arc.r * arc.r - radius * radius) / (2.0 * arc.r * d) } else { -1.0 };
+            let sweep = arc.sweep.abs();
+            if k <= -1.0 || sweep == 0.0 {
+                return Some((0.0, 1.0));
             }
+            let half = k.min(1.0).acos();
+            let mid = arc.progress(crate::geom::arc::angle_of(&v));
+            // The window in progress along the sweep, its copies a turn either side, cut to it.
+            let mut hull: Option<(f64, f64)> = None;
+            for shift in [-std::f64::consts::TAU, 0.0, std::f64::consts::TAU] {
+                let (lo, hi) = ((mid - half + shift).max(0.0), (mid + half + shift).min(sweep));
+                if lo <= hi {
+                    hull = Some(hull.map_or((lo, hi), |(a, b)| (a.min(lo), b.max(hi))));
+                }
+            }
+            hull.map(|(lo, hi)| (lo / sweep, hi / sweep))
+        }
+    }
+}
+
+/// A piece made ready for the distances of many nodes.
+enum Prepared<'a> {
+    Line(&'a Seg),
+    Arc(&'a Seg, PreparedArc),
+}
+
+impl<'a> Prepared<'a> {
+    fn of(piece: &'a Seg) -> Prepared<'a> {
+        match piece {
+            Seg::Line(..) => Prepared::Line(piece),
+            Seg::Arc(arc) => Prepared::Arc(piece, PreparedArc::new(arc)),
+        }
+    }
+
+    fn seg(&self) -> &'a Seg {
+        match self {
+            Prepared::Line(s) | Prepared::Arc(s, _) => s,
+        }
+    }
+
+    fn distance(&self, p: &P2) -> f64 {
+        match self {
+            Prepared::Line(s) => s.distance_to(p),
+            Prepared::Arc(_, a) => a.distance(p),
         }
     }
 }
@@ -340,50 +380,59 @@ fn under(piece: &Seg, p: &P2, radius: f64) -> Option<(f64, f64)> {
 /// `z0` to `z1`, the bottom taken `d` further from the axis than `p` is (so the height holds for
 /// every point within `d` of `p`); +∞ if it never covers `p` so. A value of the function evaluated
 /// at some fractions: never below the true minimum.
-fn lowest_pass(cutter: &Cutter, d: f64, piece: &Seg, z0: f64, z1: f64, p: &P2) -> f64 {
+fn lowest_pass(cutter: &Cutter, d: f64, prepared: &Prepared, z0: f64, z1: f64, p: &P2) -> f64 {
+    let nearest = prepared.distance(p);
+    if nearest + d > cutter.radius {
+        return f64::INFINITY;
+    }
+    if z0 == z1 {
+        return z0 + cutter.lift(nearest + d);
+    }
+    let piece = prepared.seg();
     let at = |t: f64| {
         let q = piece.point_at(t);
         z0 + (z1 - z0) * t + cutter.lift((q - p).norm() + d)
     };
-    let nearest = nearest_fraction(piece, p);
-    let best = at(nearest);
-    if z0 == z1 {
-        return best;
-    }
+    let best = at(nearest_fraction(piece, p));
     let Some((t0, t1)) = under(piece, p, cutter.radius - d) else { return f64::INFINITY };
-    match piece {
+    match prepared {
         // Over the fractions where a line's tool covers `p` the height is a linear term plus a
         // convex function of a convex distance: unimodal, so golden-section search finds it.
-        Seg::Line(..) => {
+        Prepared::Line(_) => {
             let g = 0.5 * (5f64.sqrt() - 1.0);
             let (mut a, mut b) = (t0, t1);
-            let (mut c, mut d) = (b - g * (b - a), a + g * (b - a));
-            let (mut fc, mut fd) = (at(c), at(d));
+            let (mut c, mut dd) = (b - g * (b - a), a + g * (b - a));
+            let (mut fc, mut fd) = (at(c), at(dd));
             for _ in 0..GOLDEN_STEPS {
                 if fc <= fd {
-                    b = d;
-                    d = c;
+                    b = dd;
+                    dd = c;
                     fd = fc;
                     c = b - g * (b - a);
                     fc = at(c);
                 } else {
                     a = c;
-                    c = d;
+                    c = dd;
                     fc = fd;
-                    d = a + g * (b - a);
-                    fd = at(d);
+                    dd = a + g * (b - a);
+                    fd = at(dd);
                 }
             }
             best.min(fc).min(fd).min(at(t0)).min(at(t1))
         }
-        // A helix: samples over the fractions that may cover `p`.
-        Seg::Arc(_) => {
-            (0..=ARC_SAMPLES).map(|k| at(t0 + (t1 - t0) * k as f64 / ARC_SAMPLES as f64)).fold(best, f64::min)
+        // A helix: samples over the fractions that may cover `p`, one per 1/64 of a half turn.
+        Prepared::Arc(..) => {
+            let turn = match piece {
+                Seg::Arc(arc) => arc.sweep.abs() * (t1 - t0),
+                Seg::Line(..) => 0.0,
+            };
+            let n = ((turn / (std::f64::consts::PI / ARC_SAMPLES as f64)).ceil() as usize).clamp(2, ARC_SAMPLES);
+            (0..=n).map(|k| at(t0 + (t1 - t0) * k as f64 / n as f64)).fold(best, f64::min)
         }
     }
 }
 
-/// Samples of a helical cut over a node.
+/// Samples of a helical cut over a node per half turn of the window it may cover it in.
 const ARC_SAMPLES: usize = 64;
 
 /// Fraction of the piece's point nearest `p`.

@@ -109,9 +109,85 @@ impl Arc2 {
     }
 }
 
+/// An arc made ready for many distance queries: its ends and their directions from the centre,
+/// so that whether a direction lies within the sweep is told by cross products, not angles.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PreparedArc {
+    /// Centre.
+    pub c: P2,
+    /// Radius.
+    pub r: f64,
+    /// Start and end points.
+    pub ends: (P2, P2),
+    /// Unit directions from the centre to the start and the end, in counter-clockwise order
+    /// (swapped for a clockwise arc).
+    dirs: (V2, V2),
+    /// The counter-clockwise sweep from `dirs.0` to `dirs.1` (radians, in (0, 2π]).
+    sweep: f64,
+}
+
+impl PreparedArc {
+    /// The arc prepared.
+    pub fn new(arc: &Arc2) -> PreparedArc {
+        let (s, e) = (arc.start_point(), arc.end_point());
+        let (a, b) = (V2::new(arc.start.cos(), arc.start.sin()), {
+            let t = arc.start + arc.sweep;
+            V2::new(t.cos(), t.sin())
+        });
+        let dirs = if arc.sweep >= 0.0 { (a, b) } else { (b, a) };
+        PreparedArc { c: arc.c, r: arc.r, ends: (s, e), dirs, sweep: arc.sweep.abs() }
+    }
+
+    /// True if the direction `v` from the centre meets the arc (the centre itself: true).
+    pub fn spans(&self, v: &V2) -> bool {
+        if self.sweep >= TAU - 1e-12 || (v.x == 0.0 && v.y == 0.0) {
+            return true;
+        }
+        let (s, e) = self.dirs;
+        if self.sweep <= PI {
+            cross2(&s, v) >= 0.0 && cross2(v, &e) >= 0.0
+        } else {
+            // Outside only if strictly inside the complement, which is under half a turn.
+            !(cross2(&e, v) > 0.0 && cross2(v, &s) > 0.0)
+        }
+    }
+
+    /// Distance from `p` to the arc, exactly (as `geom::dist::point_arc`, without angles).
+    pub fn distance(&self, p: &P2) -> f64 {
+        let v = p - self.c;
+        if self.spans(&v) { (v.norm() - self.r).abs() } else { (p - self.ends.0).norm().min((p - self.ends.1).norm()) }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The prepared distance is the angle-based one, for arcs of every sweep both ways round and
+    /// points everywhere (centre, ends, beyond).
+    #[test]
+    fn prepared_distance_is_the_exact_one() {
+        let mut k = 0u64;
+        let mut rand = || {
+            k = k.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            (k >> 11) as f64 / (1u64 << 53) as f64
+        };
+        for _ in 0..2000 {
+            let arc = Arc2 {
+                c: P2::new(1.0, -2.0),
+                r: 0.5 + 3.0 * rand(),
+                start: 7.0 * rand() - 3.5,
+                sweep: (2.0 * rand() - 1.0) * TAU,
+            };
+            let prepared = PreparedArc::new(&arc);
+            for _ in 0..20 {
+                let p = P2::new(1.0 + 10.0 * rand() - 5.0, -2.0 + 10.0 * rand() - 5.0);
+                let exact = crate::geom::dist::point_arc(&p, &arc);
+                assert!((prepared.distance(&p) - exact).abs() < 1e-12, "{arc:?} {p:?}");
+            }
+            assert_eq!(prepared.distance(&arc.c), arc.r);
+        }
+    }
 
     #[test]
     fn quarter_circle() {
