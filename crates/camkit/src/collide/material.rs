@@ -538,8 +538,8 @@ mod tests {
 
         /// A straight ramp's cut is conservative over each node's cell: no point of the cell is
         /// cut lower (by brute force over 2 000 positions of the tool along the move, at the
-        /// node and its cell's corners and edge midpoints), and the node's height is within the
-        /// brute force's own resolution of the cut at the cell's farthest reach.
+        /// node and its cell's corners and edge midpoints), and the node's height is no higher
+        /// than the brute force's lowest pass with the cell's reach.
         #[test]
         fn ramp_cuts_are_conservative_over_each_cell(
             ax in 5.0f64..35.0, ay in 5.0f64..25.0, bx in 5.0f64..35.0, by in 5.0f64..25.0,
@@ -570,7 +570,10 @@ mod tests {
                     let q = p + nalgebra::Vector2::new(0.25 * u as f64, 0.25 * v as f64);
                     prop_assert!(m.top[k] >= brute(&q, 0.0) - slack, "node {p:?}: {} below the cut at {q:?}", m.top[k]);
                 }
-                prop_assert!((m.top[k] - brute(&p, d)).abs() <= slack, "node {p:?}: {} vs {}", m.top[k], brute(&p, d));
+                // Accurate: no higher than the lowest sampled pass with the cell's reach (the samples
+                // can only miss the minimum, which near a ball's steep rim may be by more than
+                // the slack, so this side alone is exact).
+                prop_assert!(m.top[k] <= brute(&p, d) + slack, "node {p:?}: {} vs {}", m.top[k], brute(&p, d));
             }
         }
     }
