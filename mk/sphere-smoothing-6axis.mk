@@ -11,6 +11,9 @@ SPHERE_SMOOTHING_MACHINE ?= data/post-6axis/paper000-sixaxis-b.json
 SPHERE_SMOOTHING_FEED ?= 1000
 # Read-back tolerance of the NC (mm): the issue asks for the demo parts within 1 µm.
 SPHERE_SMOOTHING_NC_TOL ?= 0.001
+# Axis tolerance (degrees): the φ25 rim swings 12.5 mm × this between blocks; at the post's default
+# 0.05° that is 10.9 µm into the sphere, which the collision check refuses (tolerance 10 µm).
+SPHERE_SMOOTHING_ANGLE_TOL ?= 0.02
 # The job: stock over the cap, heights, the tool by reference (data/jobs/README.md).
 SPHERE_SMOOTHING_SETUP ?= data/jobs/sphere-smoothing.json
 
@@ -25,4 +28,5 @@ $(SPHERE_SMOOTHING_6AXIS)/tool.csv $(SPHERE_SMOOTHING_6AXIS)/tool.json &: $(SPHE
 $(SPHERE_SMOOTHING_6AXIS)/part.ngc $(SPHERE_SMOOTHING_6AXIS)/part.json &: $(SPHERE_SMOOTHING_6AXIS)/tool.csv \
   $(SPHERE_SMOOTHING_MACHINE) $(SPHERE_SMOOTHING_SETUP) $(RELEASE)/post-6axis
 	$(RELEASE)/post-6axis $< --machine $(SPHERE_SMOOTHING_MACHINE) --setup $(SPHERE_SMOOTHING_SETUP) --feed $(SPHERE_SMOOTHING_FEED) --tol $(SPHERE_SMOOTHING_NC_TOL) \
+	  --angle-tol $(SPHERE_SMOOTHING_ANGLE_TOL) \
 	  --report $(SPHERE_SMOOTHING_6AXIS)/part.json -o $(SPHERE_SMOOTHING_6AXIS)/part.ngc

@@ -7,18 +7,23 @@
 //!   a rapid straight up the tool axis moves the body into the column it stands in, which its
 //!   own cut has emptied (checked against the part only).
 //! - Rapids and feeds against the part: a 2.5-D part's walls and floor exactly
-//!   ([`camkit::collide::walls`]); every move keeps the promised clearance (the allowance) less
-//!   the setup's tolerance.
+//!   ([`camkit::collide::walls`]); a 3-D part ([`camkit::collide::solid`]) by casting the body
+//!   along each straight move with the tool's orientation held where the body allows it (a ball
+//!   end mill and its holder: exact), by the clearance at samples along the move otherwise
+//!   (every `sample` mm of tip travel and half a degree of axis turn); every move keeps the
+//!   promised clearance (the allowance) less the setup's tolerance.
 //!
 //! Blocks whose start is unknown (the first move after the tool change, a move after a G53 block)
 //! cannot be followed: they are counted, not checked.
 
 use crate::readback::{NcPose, Reading};
 use camkit::collide::material::{Cutter, Material};
+use camkit::collide::solid::{Body, Placement, Solid};
 use camkit::collide::walls::{Column, Walls};
 use camkit::contour::Seg;
 use camkit::doc::Job;
 use camkit::geom::{P2, P3, V3};
+use rayon::prelude::*;
 
 /// How the program measured.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -162,13 +167,114 @@ pub struct Check<'a> {
     pub job: &'a Job,
     /// The part's walls, if the part is given by contours.
     pub walls: Option<&'a Walls>,
+    /// The part as a solid, if it is given by a model, and the tool's body.
+    pub solid: Option<(&'a Solid, &'a Body)>,
+}
+
+/// How a program measured against a 3-D part.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct SolidOutcome {
+    /// Smallest clearance of a rapid (mm) and its NC line.
+    pub rapid: Option<(f64, u32)>,
+    /// Smallest clearance of a feed move (mm) and its NC line.
+    pub feed: Option<(f64, u32)>,
+    /// Blocks nearer the part than allowed: count, and the first (NC line, rapid, clearance).
+    pub collisions: usize,
+    /// The first of them.
+    pub first: Option<(u32, bool, f64)>,
+    /// Blocks decided by an exact cast; blocks sampled, and the samples taken.
+    pub cast: usize,
+    /// Blocks checked at samples.
+    pub sampled: usize,
+    /// Samples taken.
+    pub samples: usize,
 }
 
 fn xy(p: &P3) -> P2 {
     P2::new(p.x, p.y)
 }
 
+/// The tool's placement in the workpiece frame for controller values `q`: tip, axis, and the
+/// edge of the spindle orientation where the program commands one.
+fn placement(r: &Reading, q: &camkit::kinematics::Joints, sigma: Option<f64>) -> Placement {
+    let (tip, axis) = r.at(q);
+    let edge = sigma.and_then(|s| r.s_of(&q.rot, s)).map(|s| camkit::kinematics::edge_direction(&axis, s));
+    Placement { tip, axis, edge }
+}
+
 impl Check<'_> {
+    /// Every block against the 3-D part, in parallel (the part does not change): exact casts
+    /// where the body and the block allow them, samples every `step` mm otherwise.
+    pub fn run_solid(&self, poses: &[Option<NcPose>], r: &Reading, step: f64) -> SolidOutcome {
+        let Some((solid, body)) = self.solid else { return SolidOutcome::default() };
+        let job = self.job;
+        let limit = job.allowance - job.tolerance;
+        let reach = (job.allowance.abs() + job.approach).max(1.0) + 5.0;
+        let mut pairs = Vec::new();
+        let mut prev: Option<&NcPose> = None;
+        for pose in poses {
+            match (pose, prev) {
+                (Some(b), Some(a)) => pairs.push((a, b)),
+                _ => {}
+            }
+            prev = pose.as_ref();
+        }
+        let each: Vec<(Option<f64>, Option<f64>, bool, u32, bool, usize)> = pairs
+            .par_iter()
+            .map(|&(a, b)| {
+                let sig = |p: &NcPose| p.sigma;
+                let fixed = a.joints.rot == b.joints.rot && a.sigma == b.sigma && b.arc.is_none();
+                if fixed && body.sweeps_exactly() {
+                    let from = placement(r, &a.joints, sig(a));
+                    let to = placement(r, &b.joints, sig(b));
+                    let hit = solid.first_within(body, &from, &to.tip, limit).is_some();
+                    let end = solid.clearance(body, &to, reach);
+                    return (Some(end), hit.then_some(end.min(limit)), b.rapid, b.line, true, 0);
+                }
+                // Samples: along the block, every `step` of tip travel and 0.5° of turn.
+                let (ta, _) = r.at(&a.joints);
+                let (tb, _) = r.at(&b.joints);
+                let turn = (0..2).map(|k| (b.joints.rot[k] - a.joints.rot[k]).abs()).fold(0.0, f64::max);
+                let sweep = b.arc.map_or(0.0, |arc| {
+                    arc.in_plane(&camkit::geom::P3::from(a.joints.xyz), &camkit::geom::P3::from(b.joints.xyz))
+                        .0
+                        .length()
+                });
+                let n = (((tb - ta).norm().max(sweep) / step).max(turn / 0.5).ceil() as usize).clamp(1, 100_000);
+                let mut least = f64::INFINITY;
+                for k in 1..=n {
+                    let t = k as f64 / n as f64;
+                    let q = crate::readback::joints_at(a, b, t);
+                    let s = match (a.sigma, b.sigma) {
+                        (Some(x), Some(y)) => Some(x + (y - x) * t),
+                        (_, y) => y,
+                    };
+                    least = least.min(solid.clearance(body, &placement(r, &q, s), reach));
+                }
+                (Some(least), (least < limit - 1e-9).then_some(least), b.rapid, b.line, false, n)
+            })
+            .collect();
+        let mut o = SolidOutcome::default();
+        for (end, bad, rapid, line, cast, n) in each {
+            if let Some(c) = end {
+                least(if rapid { &mut o.rapid } else { &mut o.feed }, c, line);
+            }
+            if cast {
+                o.cast += 1;
+            } else {
+                o.sampled += 1;
+                o.samples += n;
+            }
+            if let Some(c) = bad {
+                o.collisions += 1;
+                if o.first.is_none() {
+                    o.first = Some((line, rapid, c));
+                }
+            }
+        }
+        o
+    }
+
     /// Follows the program's blocks and measures every one.
     pub fn run(&self, poses: &[Option<NcPose>], reading: &Reading) -> Result<Outcome, String> {
         let job = self.job;

@@ -12,6 +12,7 @@
 
 use crate::plan::{Cl, ClArc};
 use camkit::collide::material::{Cutter, Material};
+use camkit::collide::solid::{Body, Placement, Solid};
 use camkit::collide::walls::{Column, Walls};
 use camkit::contour::Seg;
 use camkit::doc::Job;
@@ -65,6 +66,7 @@ pub struct Linked {
 pub struct Linker<'a> {
     job: &'a Job,
     walls: Option<&'a Walls>,
+    solid: Option<(&'a Solid, &'a Body)>,
     cutter: Cutter,
     map: Material,
     file: &'a str,
@@ -111,9 +113,14 @@ pub fn cut_pieces(prev: &P3, row: &Cl) -> Vec<(Seg, f64, f64)> {
 const CHORD_SAGITTA: f64 = 0.01;
 
 impl<'a> Linker<'a> {
-    /// A linker for `job` (with the part's walls, if it has them); `file` names the rows in
-    /// messages.
-    pub fn new(job: &'a Job, walls: Option<&'a Walls>, file: &'a str) -> Result<Linker<'a>> {
+    /// A linker for `job` (with the part's walls or solid, if it has them); `file` names the rows
+    /// in messages.
+    pub fn new(
+        job: &'a Job,
+        walls: Option<&'a Walls>,
+        solid: Option<(&'a Solid, &'a Body)>,
+        file: &'a str,
+    ) -> Result<Linker<'a>> {
         let map = Material::new(&job.stock, job.resolution, MAX_NODES).map_err(|n| {
             job.error(
                 "resolution",
@@ -123,7 +130,16 @@ impl<'a> Linker<'a> {
                 ),
             )
         })?;
-        Ok(Linker { job, walls, cutter: Cutter::of(&job.tool), map, file, stats: Stats::default(), out: Vec::new() })
+        Ok(Linker {
+            job,
+            walls,
+            solid,
+            cutter: Cutter::of(&job.tool),
+            map,
+            file,
+            stats: Stats::default(),
+            out: Vec::new(),
+        })
     }
 
     fn at(&self, row: &Cl) -> Location {
@@ -390,6 +406,21 @@ impl<'a> Linker<'a> {
 
     /// Refuses a pass that starts inside the part: the post cannot reach it safely.
     fn reachable(&self, rows: &[Cl]) -> Result<()> {
+        if let Some((solid, body)) = self.solid {
+            for row in rows.iter().filter(|r| r.rapid) {
+                let edge = row.s.map(|s| camkit::kinematics::edge_direction(&row.axis, s));
+                let c = solid.clearance(body, &Placement { tip: row.tip, axis: row.axis, edge }, 1.0);
+                if c < self.job.allowance - self.job.tolerance {
+                    return Err(self.job.error(
+                        "part",
+                        format!(
+                            "the pass starting at {}:{} ({:.4}, {:.4}, {:.4}) cannot be reached safely: the tool there comes {c:.4} mm from the part's model (allowance {} mm)",
+                            self.file, row.line, row.tip.x, row.tip.y, row.tip.z, self.job.allowance
+                        ),
+                    ));
+                }
+            }
+        }
         let Some(walls) = self.walls else { return Ok(()) };
         let column = Column {
             radius: self.cutter.radius,
@@ -489,7 +520,7 @@ mod tests {
             cl(10.0, 50.0, -5.0, true),
             cl(90.0, 50.0, -5.0, false),
         ];
-        let l = Linker::new(&j, None, "t.csv").unwrap().link(&rows).unwrap();
+        let l = Linker::new(&j, None, None, "t.csv").unwrap().link(&rows).unwrap();
         let got: Vec<(f64, f64, f64, bool, Option<f64>)> =
             l.rows.iter().map(|r| (r.tip.x, r.tip.y, r.tip.z, r.rapid, if r.rapid { None } else { r.feed })).collect();
         let want = vec![
@@ -521,17 +552,17 @@ mod tests {
             cl(50.0, 10.0, -8.0, true),
             cl(60.0, 10.0, -8.0, false),
         ];
-        let l = Linker::new(&j, None, "t.csv").unwrap().link(&rows).unwrap();
+        let l = Linker::new(&j, None, None, "t.csv").unwrap().link(&rows).unwrap();
         assert!(l.rows.iter().any(|r| r.rapid && r.tip == P3::new(50.0, 10.0, -4.0)), "{:?}", l.rows);
         assert_eq!(l.stats.plunge_mm, 6.0 + 4.0);
         // Stock 8 mm above the part (and the safe height): a traverse along the cut slot stays at
         // the safe height, one across uncut stock goes over at the clearance height.
         let mut tall = job(8.0, 5.0, None);
         tall.part_top = 0.0;
-        let l = Linker::new(&tall, None, "t.csv").unwrap().link(&rows).unwrap();
+        let l = Linker::new(&tall, None, None, "t.csv").unwrap().link(&rows).unwrap();
         assert_eq!(l.stats.at_clearance, 0, "{:?}", l.rows);
         let across = [rows[0], rows[1], cl(50.0, 40.0, -8.0, true), cl(60.0, 40.0, -8.0, false)];
-        let l = Linker::new(&tall, None, "t.csv").unwrap().link(&across).unwrap();
+        let l = Linker::new(&tall, None, None, "t.csv").unwrap().link(&across).unwrap();
         assert_eq!(l.stats.at_clearance, 1);
         let traverse = l.rows.iter().find(|r| r.reorient && r.tip.x == 50.0).unwrap();
         assert_eq!(traverse.tip.z, 30.0);
@@ -543,7 +574,7 @@ mod tests {
     fn ramps_descend_at_the_angle_along_the_pass() {
         let j = job(0.0, 5.0, Some(3.0));
         let rows = [cl(10.0, 10.0, -5.0, true), cl(20.0, 10.0, -5.0, false), cl(20.0, 30.0, -5.0, false)];
-        let l = Linker::new(&j, None, "t.csv").unwrap().link(&rows).unwrap();
+        let l = Linker::new(&j, None, None, "t.csv").unwrap().link(&rows).unwrap();
         assert_eq!((l.stats.ramps, l.stats.plunges), (1, 0));
         let start = l.rows.iter().position(|r| !r.rapid).unwrap();
         let ramp: Vec<&Cl> =
@@ -565,14 +596,14 @@ mod tests {
     fn toolpaths_outside_the_stock_are_refused() {
         let j = job(0.0, 5.0, None);
         let rows = [cl(10.0, 10.0, -5.0, true), cl(120.0, 10.0, -5.0, false)];
-        let e = Linker::new(&j, None, "t.csv").unwrap().link(&rows).unwrap_err();
+        let e = Linker::new(&j, None, None, "t.csv").unwrap().link(&rows).unwrap_err();
         assert!(e.to_string().starts_with("s.json (stock): the stock does not contain the toolpath: t.csv:2"), "{e}");
         let rows = [cl(10.0, 10.0, -5.0, true), cl(20.0, 10.0, -31.0, false)];
-        let e = Linker::new(&j, None, "t.csv").unwrap().link(&rows).unwrap_err();
+        let e = Linker::new(&j, None, None, "t.csv").unwrap().link(&rows).unwrap_err();
         assert!(e.to_string().contains("below the stock"), "{e}");
         let mut tilted = cl(10.0, 10.0, -5.0, true);
         tilted.axis = V3::new(1.0, 0.0, 0.05).normalize();
-        let e = Linker::new(&j, None, "t.csv").unwrap().link(&[tilted]).unwrap_err();
+        let e = Linker::new(&j, None, None, "t.csv").unwrap().link(&[tilted]).unwrap_err();
         assert!(e.to_string().contains("cannot be approached along its axis"), "{e}");
     }
 }

@@ -1,6 +1,7 @@
 //! `post-6axis`: CL rows to NC for a machine described in JSON, checked by reading the NC back.
 
 use camkit::cli::{self, IoArgs, positive};
+use camkit::collide::solid::{Body, Solid};
 use camkit::collide::walls::Walls;
 use camkit::doc::Frame;
 use camkit::doc::Setup;
@@ -150,7 +151,9 @@ fn run(args: Args) -> Result<()> {
         read_axes(&nc_input.name, text)?;
         report.set("program", &nc_input.name);
         let walls = walls_of(j);
-        let failed = collide(text.as_bytes(), &machine, &chain, j, walls.as_ref(), &args, &mut report);
+        let solid = solid_of(j)?;
+        let parts = (walls.as_ref(), solid.as_ref().map(|(s, b)| (s, b)));
+        let failed = collide(text.as_bytes(), &machine, &chain, j, parts, &args, &mut report);
         out.buf = report.to_json().into_bytes();
         finish(out, &args, report)?;
         return failed;
@@ -199,9 +202,11 @@ fn run(args: Args) -> Result<()> {
         format!("tolerance {} mm, {} deg", settings.tol, settings.angle_tol),
     ];
     let walls = job.as_ref().and_then(walls_of);
+    let solid = job.as_ref().map(solid_of).transpose()?.flatten();
+    let solid_ref = solid.as_ref().map(|(s, b)| (s, b));
     let rows = match &job {
         Some(j) => {
-            let linked = link::Linker::new(j, walls.as_ref(), &input.name)?.link(&rows)?;
+            let linked = link::Linker::new(j, walls.as_ref(), solid_ref, &input.name)?.link(&rows)?;
             comments.push(format!(
                 "setup {}: tool T{} from {}, clearance Z{} safe Z{} approach {} mm",
                 j.file,
@@ -224,7 +229,7 @@ fn run(args: Args) -> Result<()> {
         ));
     }
     if let Some(j) = &job {
-        collide(&posted.text, &machine, &chain, j, walls.as_ref(), &args, &mut report)?;
+        collide(&posted.text, &machine, &chain, j, (walls.as_ref(), solid_ref), &args, &mut report)?;
     }
     out.buf = posted.text;
     if posted.plan.singular_rows > 0 {
@@ -279,12 +284,23 @@ fn walls_of(job: &Job) -> Option<Walls> {
     }
 }
 
+/// The part as a solid and the tool's body, when the setup gives the part by a model: patches
+/// tessellated within a quarter of the tolerance (at most 2 µm).
+fn solid_of(job: &Job) -> Result<Option<(Solid, Body)>> {
+    let Some(Part::Model(model)) = &job.part else { return Ok(None) };
+    let solid = Solid::of(model, (0.25 * job.tolerance).min(0.002)).map_err(|e| job.error("part.model", e))?;
+    Ok(Some((solid, Body::of(&job.tool))))
+}
+
+/// The parts a program is checked against: walls, or a solid with the tool's body.
+type Parts<'a> = (Option<&'a Walls>, Option<(&'a Solid, &'a Body)>);
+
 fn collide(
     text: &[u8],
     machine: &Machine,
     chain: &Chain,
     job: &Job,
-    walls: Option<&Walls>,
+    (walls, solid): Parts,
     args: &Args,
     report: &mut Report,
 ) -> Result<()> {
@@ -292,8 +308,28 @@ fn collide(
     let program = read_axes("written program", text)?;
     let reading = readback::Reading::new(machine, chain);
     let poses = readback::poses(&program, &reading);
-    let check = collision::Check { job, walls };
-    let o = check.run(&poses, &reading).map_err(Error::runtime)?;
+    let check = collision::Check { job, walls, solid };
+    let mut o = check.run(&poses, &reading).map_err(Error::runtime)?;
+    let so = check.run_solid(&poses, &reading, job.resolution);
+    let low = |a: Option<(f64, u32)>, b: Option<(f64, u32)>| match (a, b) {
+        (Some(x), Some(y)) => Some(if y.0 < x.0 { y } else { x }),
+        (x, y) => x.or(y),
+    };
+    o.feed_clearance = low(o.feed_clearance, so.feed);
+    o.rapid_part_clearance = low(o.rapid_part_clearance, so.rapid);
+    o.part_collisions += so.collisions;
+    if let Some((line, rapid, c)) = so.first
+        && o.first.as_ref().is_none_or(|(l, _)| line < *l)
+    {
+        let kind = if rapid { "a rapid (G0)" } else { "a feed move" };
+        o.first = Some((
+            line,
+            format!(
+                "{kind} comes {c:.4} mm from the part's model, less than the allowance {} mm (tolerance {} mm)",
+                job.allowance, job.tolerance
+            ),
+        ));
+    }
     let pair = |v: Option<(f64, u32)>| v.map(|(c, _)| c);
     let line = |v: Option<(f64, u32)>| v.map(|(_, l)| l);
     report
@@ -311,7 +347,19 @@ fn collide(
         .set("part_collisions", o.part_collisions)
         .set("unchecked_blocks", o.unchecked_blocks)
         .set("tilted_cuts_not_mapped", o.tilted_cuts)
-        .set("part_checked", if walls.is_some() { "walls" } else { "none" });
+        .set(
+            "part_checked",
+            match (walls.is_some(), solid) {
+                (true, _) => "walls".to_string(),
+                (_, Some((_, body))) if body.sweeps_exactly() => "model: every move cast exactly".to_string(),
+                (_, Some(_)) => format!("model: the clearance every {} mm along the moves", job.resolution),
+                _ => "none".to_string(),
+            },
+        )
+        .set("part_blocks_cast", so.cast)
+        .set("part_blocks_sampled", so.sampled)
+        .set("part_samples", so.samples)
+        .set("model_chord_error_mm", solid.map(|(s, _)| s.chord_error()));
     if let Some((nc_line, what)) = &o.first {
         let message = format!(
             "collision check: NC line {nc_line}: {what} ({} rapids into material, {} moves too near the part)",

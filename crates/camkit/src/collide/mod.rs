@@ -2,4 +2,5 @@
 //! walls of a 2.5-D part ([`walls`]), measured exactly where they can be.
 
 pub mod material;
+pub mod solid;
 pub mod walls;
