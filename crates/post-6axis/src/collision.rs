@@ -194,6 +194,18 @@ fn xy(p: &P3) -> P2 {
     P2::new(p.x, p.y)
 }
 
+/// One block measured against a 3-D part.
+struct BlockSolid {
+    /// Smallest clearance seen (mm): at the block's end when cast, over the samples otherwise.
+    least: f64,
+    /// The clearance of a block nearer the part than allowed.
+    bad: Option<f64>,
+    rapid: bool,
+    line: u32,
+    /// Samples taken (`None`: cast exactly).
+    samples: Option<usize>,
+}
+
 /// The tool's placement in the workpiece frame for controller values `q`: tip, axis, and the
 /// edge of the spindle orientation where the program commands one.
 fn placement(r: &Reading, q: &camkit::kinematics::Joints, sigma: Option<f64>) -> Placement {
@@ -213,13 +225,12 @@ impl Check<'_> {
         let mut pairs = Vec::new();
         let mut prev: Option<&NcPose> = None;
         for pose in poses {
-            match (pose, prev) {
-                (Some(b), Some(a)) => pairs.push((a, b)),
-                _ => {}
+            if let (Some(b), Some(a)) = (pose, prev) {
+                pairs.push((a, b));
             }
             prev = pose.as_ref();
         }
-        let each: Vec<(Option<f64>, Option<f64>, bool, u32, bool, usize)> = pairs
+        let each: Vec<BlockSolid> = pairs
             .par_iter()
             .map(|&(a, b)| {
                 let sig = |p: &NcPose| p.sigma;
@@ -229,7 +240,13 @@ impl Check<'_> {
                     let to = placement(r, &b.joints, sig(b));
                     let hit = solid.first_within(body, &from, &to.tip, limit).is_some();
                     let end = solid.clearance(body, &to, reach);
-                    return (Some(end), hit.then_some(end.min(limit)), b.rapid, b.line, true, 0);
+                    return BlockSolid {
+                        least: end,
+                        bad: hit.then_some(end.min(limit)),
+                        rapid: b.rapid,
+                        line: b.line,
+                        samples: None,
+                    };
                 }
                 // Samples: along the block, every `step` of tip travel and 0.5° of turn.
                 let (ta, _) = r.at(&a.joints);
@@ -251,24 +268,29 @@ impl Check<'_> {
                     };
                     least = least.min(solid.clearance(body, &placement(r, &q, s), reach));
                 }
-                (Some(least), (least < limit - 1e-9).then_some(least), b.rapid, b.line, false, n)
+                BlockSolid {
+                    least,
+                    bad: (least < limit - 1e-9).then_some(least),
+                    rapid: b.rapid,
+                    line: b.line,
+                    samples: Some(n),
+                }
             })
             .collect();
         let mut o = SolidOutcome::default();
-        for (end, bad, rapid, line, cast, n) in each {
-            if let Some(c) = end {
-                least(if rapid { &mut o.rapid } else { &mut o.feed }, c, line);
+        for b in each {
+            least(if b.rapid { &mut o.rapid } else { &mut o.feed }, b.least, b.line);
+            match b.samples {
+                None => o.cast += 1,
+                Some(n) => {
+                    o.sampled += 1;
+                    o.samples += n;
+                }
             }
-            if cast {
-                o.cast += 1;
-            } else {
-                o.sampled += 1;
-                o.samples += n;
-            }
-            if let Some(c) = bad {
+            if let Some(c) = b.bad {
                 o.collisions += 1;
                 if o.first.is_none() {
-                    o.first = Some((line, rapid, c));
+                    o.first = Some((b.line, b.rapid, c));
                 }
             }
         }
