@@ -376,3 +376,47 @@ fn output_is_the_same_for_any_thread_count() {
     };
     assert_eq!(run("1"), run("3"));
 }
+
+/// `--axis`: a ball end mill on a fixed axis from a stylus trace of a sphere (stylus of the tool's
+/// radius): every tip 3 below its stylus centre, the ball tangent to the sphere (its centre 53 from
+/// the sphere's), no gouge by the model check; a tilted fixed axis moves the tip along it; flat
+/// tools, zero and malformed axes, and --axis with --tilt are refused.
+#[test]
+fn fixed_axis_ball_tips_from_a_stylus_trace() {
+    let w = Work::new();
+    w.write("sphere.json", r#"{"surfaces": [{"type": "sphere", "centre": [0, 0, -50], "radius": 50}]}"#);
+    w.write("ball.json", r#"{"kind": "ball", "radius": 3, "length": 20}"#);
+    w.write("flat.json", r#"{"kind": "flat", "radius": 3}"#);
+    let cl = w
+        .run("stylus-trace", &["sphere.json", "--mode", "scan", "-r", "3", "--pick", "4", "--region=-20,20,-8,8"], b"")
+        .ok();
+    w.write("cl.csv", &cl);
+    let out = w
+        .run(
+            BIN,
+            &["cl.csv", "--tool", "ball.json", "--axis", "0,0,1", "--model", "sphere.json", "--report", "r.json"],
+            b"",
+        )
+        .ok();
+    let (c, s) = (Rows::parse(&out), Rows::parse(&cl));
+    assert_eq!(c.rows.len(), s.rows.len());
+    assert!(c.rows.len() > 50);
+    for k in 0..c.rows.len() {
+        let (tip, centre) = (c.tip(k), s.tip(k));
+        assert!((centre - tip - V3::new(0.0, 0.0, 3.0)).norm() < 1e-9, "row {k}");
+        assert!((((tip + V3::new(0.0, 0.0, 3.0)) - P3::new(0.0, 0.0, -50.0)).norm() - 53.0).abs() < 1e-6);
+        assert!((c.axis(k) - V3::z()).norm() < 1e-12);
+    }
+    let r: serde_json::Value = serde_json::from_str(&w.read("r.json")).unwrap();
+    assert!(r["largest_gouge_mm"].as_f64().unwrap() < 1e-6, "{r}");
+    let tilted = w.run(BIN, &["cl.csv", "--tool", "ball.json", "--axis", "0,3,4"], b"").ok();
+    let t = Rows::parse(&tilted);
+    assert!((s.tip(0) - t.tip(0) - V3::new(0.0, 1.8, 2.4)).norm() < 1e-9);
+    w.run(BIN, &["cl.csv", "--tool", "flat.json", "--axis", "0,0,1"], b"")
+        .fails(2, "flat.json (kind): --axis (a fixed axis) takes a ball end mill");
+    w.run(BIN, &["cl.csv", "--tool", "ball.json", "--axis", "0,0,0"], b"")
+        .fails(2, "--axis must be a nonzero direction");
+    w.run(BIN, &["cl.csv", "--tool", "ball.json", "--axis", "0,1"], b"").fails(2, "--axis takes three numbers");
+    let o = w.run(BIN, &["cl.csv", "--tool", "ball.json", "--axis", "0,0,1", "--tilt", "3"], b"");
+    assert_eq!(o.status, 2, "{}", o.stderr);
+}

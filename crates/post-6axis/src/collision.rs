@@ -194,6 +194,9 @@ fn xy(p: &P3) -> P2 {
     P2::new(p.x, p.y)
 }
 
+/// How far beyond the allowance and the tolerance clearances from a 3-D part are measured (mm).
+pub const SOLID_BAND: f64 = 0.1;
+
 /// One block measured against a 3-D part.
 struct BlockSolid {
     /// Smallest clearance seen (mm): at the block's end when cast, over the samples otherwise.
@@ -204,6 +207,55 @@ struct BlockSolid {
     line: u32,
     /// Samples taken (`None`: cast exactly).
     samples: Option<usize>,
+}
+
+/// One block against a 3-D part: cast exactly where the body and the block allow, sampled
+/// otherwise.
+#[allow(clippy::too_many_arguments)]
+fn block_solid(
+    solid: &Solid,
+    body: &Body,
+    r: &Reading,
+    a: &NcPose,
+    b: &NcPose,
+    limit: f64,
+    reach: f64,
+    step: f64,
+) -> BlockSolid {
+    let sig = |p: &NcPose| p.sigma;
+    let fixed = a.joints.rot == b.joints.rot && a.sigma == b.sigma && b.arc.is_none();
+    if fixed && body.sweeps_exactly() {
+        let from = placement(r, &a.joints, sig(a));
+        let to = placement(r, &b.joints, sig(b));
+        let hit = solid.first_within(body, &from, &to.tip, limit).is_some();
+        let end = solid.clearance(body, &to, reach);
+        return BlockSolid {
+            least: end,
+            bad: hit.then_some(end.min(limit)),
+            rapid: b.rapid,
+            line: b.line,
+            samples: None,
+        };
+    }
+    // Samples: along the block, every `step` of tip travel and 0.5° of turn.
+    let (ta, _) = r.at(&a.joints);
+    let (tb, _) = r.at(&b.joints);
+    let turn = (0..2).map(|k| (b.joints.rot[k] - a.joints.rot[k]).abs()).fold(0.0, f64::max);
+    let sweep = b.arc.map_or(0.0, |arc| {
+        arc.in_plane(&camkit::geom::P3::from(a.joints.xyz), &camkit::geom::P3::from(b.joints.xyz)).0.length()
+    });
+    let n = (((tb - ta).norm().max(sweep) / step).max(turn / 0.5).ceil() as usize).clamp(1, 100_000);
+    let mut least = f64::INFINITY;
+    for k in 1..=n {
+        let t = k as f64 / n as f64;
+        let q = crate::readback::joints_at(a, b, t);
+        let s = match (a.sigma, b.sigma) {
+            (Some(x), Some(y)) => Some(x + (y - x) * t),
+            (_, y) => y,
+        };
+        least = least.min(solid.clearance(body, &placement(r, &q, s), reach));
+    }
+    BlockSolid { least, bad: (least < limit - 1e-9).then_some(least), rapid: b.rapid, line: b.line, samples: Some(n) }
 }
 
 /// The tool's placement in the workpiece frame for controller values `q`: tip, axis, and the
@@ -221,7 +273,9 @@ impl Check<'_> {
         let Some((solid, body)) = self.solid else { return SolidOutcome::default() };
         let job = self.job;
         let limit = job.allowance - job.tolerance;
-        let reach = (job.allowance.abs() + job.approach).max(1.0) + 5.0;
+        // Clearances are measured in a band 0.1 mm beyond the allowance and the tolerance (farther
+        // ones are reported as the band's edge): the fewer triangles a query meets, the faster.
+        let reach = job.allowance.max(0.0) + job.tolerance + SOLID_BAND;
         let mut pairs = Vec::new();
         let mut prev: Option<&NcPose> = None;
         for pose in poses {
@@ -230,53 +284,8 @@ impl Check<'_> {
             }
             prev = pose.as_ref();
         }
-        let each: Vec<BlockSolid> = pairs
-            .par_iter()
-            .map(|&(a, b)| {
-                let sig = |p: &NcPose| p.sigma;
-                let fixed = a.joints.rot == b.joints.rot && a.sigma == b.sigma && b.arc.is_none();
-                if fixed && body.sweeps_exactly() {
-                    let from = placement(r, &a.joints, sig(a));
-                    let to = placement(r, &b.joints, sig(b));
-                    let hit = solid.first_within(body, &from, &to.tip, limit).is_some();
-                    let end = solid.clearance(body, &to, reach);
-                    return BlockSolid {
-                        least: end,
-                        bad: hit.then_some(end.min(limit)),
-                        rapid: b.rapid,
-                        line: b.line,
-                        samples: None,
-                    };
-                }
-                // Samples: along the block, every `step` of tip travel and 0.5° of turn.
-                let (ta, _) = r.at(&a.joints);
-                let (tb, _) = r.at(&b.joints);
-                let turn = (0..2).map(|k| (b.joints.rot[k] - a.joints.rot[k]).abs()).fold(0.0, f64::max);
-                let sweep = b.arc.map_or(0.0, |arc| {
-                    arc.in_plane(&camkit::geom::P3::from(a.joints.xyz), &camkit::geom::P3::from(b.joints.xyz))
-                        .0
-                        .length()
-                });
-                let n = (((tb - ta).norm().max(sweep) / step).max(turn / 0.5).ceil() as usize).clamp(1, 100_000);
-                let mut least = f64::INFINITY;
-                for k in 1..=n {
-                    let t = k as f64 / n as f64;
-                    let q = crate::readback::joints_at(a, b, t);
-                    let s = match (a.sigma, b.sigma) {
-                        (Some(x), Some(y)) => Some(x + (y - x) * t),
-                        (_, y) => y,
-                    };
-                    least = least.min(solid.clearance(body, &placement(r, &q, s), reach));
-                }
-                BlockSolid {
-                    least,
-                    bad: (least < limit - 1e-9).then_some(least),
-                    rapid: b.rapid,
-                    line: b.line,
-                    samples: Some(n),
-                }
-            })
-            .collect();
+        let each: Vec<BlockSolid> =
+            pairs.par_iter().map(|&(a, b)| block_solid(solid, body, r, a, b, limit, reach, step)).collect();
         let mut o = SolidOutcome::default();
         for b in each {
             least(if b.rapid { &mut o.rapid } else { &mut o.feed }, b.least, b.line);

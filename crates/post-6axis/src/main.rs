@@ -204,9 +204,11 @@ fn run(args: Args) -> Result<()> {
     let walls = job.as_ref().and_then(walls_of);
     let solid = job.as_ref().map(solid_of).transpose()?.flatten();
     let solid_ref = solid.as_ref().map(|(s, b)| (s, b));
+    let link_started = Instant::now();
     let rows = match &job {
         Some(j) => {
             let linked = link::Linker::new(j, walls.as_ref(), solid_ref, &input.name)?.link(&rows)?;
+            report.set("link_seconds", link_started.elapsed().as_secs_f64());
             comments.push(format!(
                 "setup {}: tool T{} from {}, clearance Z{} safe Z{} approach {} mm",
                 j.file,
@@ -221,7 +223,9 @@ fn run(args: Args) -> Result<()> {
         }
         None => rows,
     };
+    let post_started = Instant::now();
     let posted = post(&rows, &input.name, &machine, &chain, &settings, comments)?;
+    report.set("post_seconds", post_started.elapsed().as_secs_f64());
     let passes = rows.iter().filter(|r| r.rapid).count();
     if job.is_none() && passes > 1 {
         cli::warn(&format!(
@@ -309,8 +313,12 @@ fn collide(
     let reading = readback::Reading::new(machine, chain);
     let poses = readback::poses(&program, &reading);
     let check = collision::Check { job, walls, solid };
+    let started = Instant::now();
     let mut o = check.run(&poses, &reading).map_err(Error::runtime)?;
+    report.set("material_check_seconds", started.elapsed().as_secs_f64());
+    let started = Instant::now();
     let so = check.run_solid(&poses, &reading, job.resolution);
+    report.set("part_check_seconds", started.elapsed().as_secs_f64());
     let low = |a: Option<(f64, u32)>, b: Option<(f64, u32)>| match (a, b) {
         (Some(x), Some(y)) => Some(if y.0 < x.0 { y } else { x }),
         (x, y) => x.or(y),

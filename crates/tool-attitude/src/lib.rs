@@ -129,6 +129,14 @@ impl std::fmt::Display for RowError {
     }
 }
 
+/// The tip of a ball end mill of radius `r` held along the fixed unit `axis` whose ball centre is
+/// the stylus centre `centre` (a stylus of the same radius traced the model): tip = centre − r·axis.
+/// The stylus centre is where the ball's centre must be whatever the axis, so the ball touches the
+/// model as the stylus did.
+pub fn fixed_axis_ball_tip(centre: &P3, axis: &V3, r: f64) -> P3 {
+    centre - axis * r
+}
+
 /// The attitude of one row; with a model, the tool body is checked and the tilt adjusted inside
 /// the range where the tool has a free tilt (cylinder, ball).
 pub fn attitude(setup: &Setup, c: &Contact, model: Option<&Model>) -> Result<Attitude, RowError> {

@@ -57,6 +57,11 @@ struct Args {
     /// The tool document (JSON: kind, radius, ...).
     #[arg(short = 't', long, value_name = "FILE")]
     tool: String,
+    /// A fixed tool axis I,J,K (e.g. 0,0,1 for a 3-axis machine; normalised) for a ball end mill:
+    /// the tip is the stylus centre less R along it (the stylus must have the tool's radius), the
+    /// axis columns this vector; with --model the ball and shank are gouge-checked.
+    #[arg(long, value_name = "I,J,K", allow_hyphen_values = true, conflicts_with_all = ["tilt", "edge_radius"])]
+    axis: Option<String>,
     /// Tilt (degrees): θ of the cylindrical tool (paper's sign: negative leans toward the feed;
     /// default −5), ζ of the ball end mill (default 0).
     #[arg(long, value_name = "DEG", conflicts_with = "edge_radius")]
@@ -270,11 +275,118 @@ fn contacts(t: &Table, file: &str, model: Option<&Model>, needs_second: bool) ->
     Ok(out)
 }
 
+/// The fixed tool axis of `--axis`, unit; a zero, malformed or non-finite vector is a usage error.
+fn fixed_axis(text: &str) -> Result<V3> {
+    let parts: Vec<f64> = text
+        .split(',')
+        .map(|p| p.trim().parse::<f64>())
+        .collect::<std::result::Result<_, _>>()
+        .map_err(|_| Error::input(format!("--axis takes three numbers I,J,K, got `{text}`")))?;
+    let v = match parts[..] {
+        [i, j, k] => V3::new(i, j, k),
+        _ => return Err(Error::input(format!("--axis takes three numbers I,J,K, got `{text}`"))),
+    };
+    let n = v.norm();
+    if !(n.is_finite() && n > 1e-9) {
+        return Err(Error::input(format!("--axis must be a nonzero direction, got `{text}`")));
+    }
+    Ok(v / n)
+}
+
+/// `--axis`: tips of a ball end mill on a fixed axis from the stylus centres.
+fn run_fixed(args: &Args, tool: &Tool, tool_file: &str, axis: V3, started: Instant) -> Result<()> {
+    if tool.kind != ToolKind::Ball {
+        return Err(field_error(
+            tool_file,
+            "kind",
+            "--axis (a fixed axis) takes a ball end mill: the stylus centre is its ball's centre; flat, bull-nose and cone cutters on a fixed axis need a drop-cutter, which tool-attitude does not do",
+        ));
+    }
+    let input = Input::open(&args.io.input)?;
+    let mut t = table::read(&input, &[Col::X, Col::Y, Col::Z])?;
+    if t.rows.is_empty() {
+        return Err(Error::input("no rows").at(Location::file(&input.name)));
+    }
+    let model = match &args.model {
+        Some(m) => Some(Model::load(&Input::open(m)?)?),
+        None => None,
+    };
+    let r = tool.radius;
+    let length = tool.length.unwrap_or(4.0 * r);
+    t.schema.add(&[Col::I, Col::J, Col::K]);
+    let c_gouge = model.is_some().then(|| t.add_extra_column("gouge"));
+    let gouges: Vec<f64> = t
+        .rows
+        .par_iter()
+        .map(|row| {
+            let tip = tool_attitude::fixed_axis_ball_tip(&row.pos, &axis, r);
+            model.as_ref().map_or(0.0, |m| {
+                tool_attitude::gouge::penetration(m, &tool_attitude::gouge::ball_probes(&tip, &axis, r, length))
+            })
+        })
+        .collect();
+    let num = |v: f64| {
+        let mut b = Vec::new();
+        camkit::num::push_shortest(&mut b, v);
+        String::from_utf8(b).expect("ascii")
+    };
+    let mut gouging = Vec::new();
+    for (k, (row, g)) in t.rows.iter_mut().zip(&gouges).enumerate() {
+        row.pos = tool_attitude::fixed_axis_ball_tip(&row.pos, &axis, r);
+        row.axis = axis;
+        if let Some(i) = c_gouge {
+            row.extra[i] = num(*g);
+            if *g > args.gouge_tol {
+                gouging.push(k);
+            }
+        }
+    }
+    let largest = gouges.iter().copied().fold(0.0, f64::max);
+    let mut report = Report::new("tool-attitude");
+    report
+        .set("tool", tool)
+        .set("fixed_axis", [axis.x, axis.y, axis.z])
+        .set("rows", t.rows.len())
+        .set("paths", t.passes().count())
+        .set("gouge_rows", gouging.len())
+        .set("gouge_tol_mm", args.gouge_tol)
+        .set("largest_gouge_mm", largest)
+        .set("seconds", started.elapsed().as_secs_f64());
+    if let Some(path) = &args.io.report {
+        report.write(path)?;
+    }
+    if let Some(&k) = gouging.first() {
+        let msg = format!(
+            "{} row(s) gouge the model by more than {} mm (deepest {largest:.6} mm)",
+            gouging.len(),
+            args.gouge_tol
+        );
+        let loc = Location::file(&input.name).line(t.rows[k].line);
+        if !args.allow_gouge {
+            return Err(Error::check(msg).at(loc));
+        }
+        cli::warn(&format!("{loc}: {msg}"));
+    }
+    let mut out = Output::new(args.io.output.as_deref());
+    table::write(&mut out, &t, &WriteOptions { decimals: args.decimals })?;
+    out.commit()
+}
+
 fn run(args: Args) -> Result<()> {
     let started = Instant::now();
     let tool_input = Input::open(&args.tool)?;
     let tool: Tool = camkit::json::from_input(&tool_input)?;
     tool.validate(&tool_input.name)?;
+    if let Some(text) = &args.axis {
+        if args.decimals.is_some_and(|d| d > 12) {
+            return Err(Error::input("--decimals must be at most 12"));
+        }
+        if !(args.gouge_tol.is_finite() && args.gouge_tol >= 0.0) {
+            return Err(Error::input(format!("--gouge-tol must be a number ≥ 0, got {}", args.gouge_tol)));
+        }
+        let axis = fixed_axis(text)?;
+        return run_fixed(&args, &tool, &tool_input.name, axis, started);
+    }
     let setup = setup(&args, &tool, &tool_input.name)?;
     let model = match &args.model {
         Some(m) => Some(Model::load(&Input::open(m)?)?),
