@@ -4,11 +4,11 @@
 # radius (one-way lines, MOULD_PICK apart), tool-attitude puts the tips on the fixed vertical axis
 # (tip = stylus centre − 3 along z), post-6axis links the lines through the job's safe height and
 # checks the program against the stock it has cut and the mould itself (the ball and its holder
-# cast along every move), curve-fit-arcs turns the program's G1 runs into arcs within
-# MOULD_FIT_TOL, and the fitted program is checked again (`post-6axis --check`). The variant
-# confined to the dish (MOULD_CAVITY) has every line start and end below the stock top: posted as
-# given (naive-cavity.nc, straight G0s from line to line) the same check finds its rapids cutting
-# through the rim (naive-cavity-check.json); linked, none do.
+# cast along every move), curve-fit-arcs turns the program's G1 runs into arcs in the planes they
+# lie in (the raster's are XZ: G18) within MOULD_FIT_TOL, and the fitted program is checked again
+# (`post-6axis --check`). The variant confined to the dish (MOULD_CAVITY) has every line start and
+# end below the stock top: posted as given (naive-cavity.nc, straight G0s from line to line) the
+# same check finds its rapids cutting through uncut stock (naive-cavity-check.json); linked, none.
 DEMOS += mould-3axis
 FILTERS += stylus-trace tool-attitude post-6axis curve-fit-arcs
 MOULD := $(OUT)/mould-3axis
@@ -55,7 +55,7 @@ $(MOULD)/mould-cavity.ngc $(MOULD)/mould-cavity.json &: $(MOULD)/tip-cavity.csv 
 
 # The program's G1 runs as arcs, then the same collision check on the fitted program.
 $(MOULD)/mould-fit.ngc $(MOULD)/mould-fit.json &: $(MOULD)/mould.ngc $(MOULD)/setup.json $(RELEASE)/curve-fit-arcs $(RELEASE)/post-6axis
-	$(RELEASE)/curve-fit-arcs $< --tol $(MOULD_FIT_TOL) --report $(MOULD)/mould-fit-arcs.json -o $(MOULD)/mould-fit.ngc
+	$(RELEASE)/curve-fit-arcs $< --tol $(MOULD_FIT_TOL) --plane auto --report $(MOULD)/mould-fit-arcs.json -o $(MOULD)/mould-fit.ngc
 	$(RELEASE)/post-6axis --machine $(MOULD_MACHINE) --setup $(MOULD)/setup.json --check $(MOULD)/mould-fit.ngc > $(MOULD)/mould-fit.json
 
 # The cavity raster posted as given (no setup) and checked: what straight G0s would do.

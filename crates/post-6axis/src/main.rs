@@ -357,10 +357,14 @@ fn collide(
         .set("tilted_cuts_not_mapped", o.tilted_cuts)
         .set(
             "part_checked",
-            match (walls.is_some(), solid) {
+            match (walls.is_some(), solid.is_some()) {
                 (true, _) => "walls".to_string(),
-                (_, Some((_, body))) if body.sweeps_exactly() => "model: every move cast exactly".to_string(),
-                (_, Some(_)) => format!("model: the clearance every {} mm along the moves", job.resolution),
+                (_, true) if so.sampled == 0 => "model: every move cast exactly".to_string(),
+                (_, true) if so.cast == 0 => format!("model: the clearance every {} mm along the moves", job.resolution),
+                (_, true) => format!(
+                    "model: straight moves cast exactly, arcs and turning moves at samples every {} mm",
+                    job.resolution
+                ),
                 _ => "none".to_string(),
             },
         )
