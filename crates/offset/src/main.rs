@@ -5,9 +5,8 @@ use camkit::contour::OffsetOptions;
 use camkit::contour::offset::Side;
 use camkit::contour::pocket::{Direction, PocketOptions};
 use camkit::error::{Error, Location, Result};
-use camkit::geom::P3;
 use camkit::io::{Input, Output, write_atomic};
-use camkit::table::{self, Col, Move, Row, Table, WriteOptions};
+use camkit::table::{self, Col, WriteOptions};
 use clap::{Parser, ValueEnum};
 use offset::profile::Tool;
 use offset::{Outcome, Up, space};
@@ -99,12 +98,10 @@ struct Args {
     /// Input format.
     #[arg(long, value_enum, default_value_t = Kind::Auto)]
     from: Kind,
-    /// Output format: the table, or a 3-axis G-code program.
+    /// Output format: the table (the only one: `offset | post-6axis --setup` makes the program,
+    /// with linked, collision-checked passes).
     #[arg(long, value_enum, default_value_t = Kind::Table)]
     to: Kind,
-    /// G-code: height above the highest point for moves between passes (mm).
-    #[arg(long, default_value_t = 5.0, value_name = "MM")]
-    clearance: f64,
     /// Feed (mm/min) for rows that have none.
     #[arg(long, value_name = "MM/MIN")]
     feed: Option<f64>,
@@ -168,7 +165,11 @@ fn side(args: &Args, needed: bool) -> Result<Side> {
 fn run(args: Args) -> Result<()> {
     let started = Instant::now();
     let r = positive(args.radius, "--radius")?;
-    positive(args.clearance, "--clearance")?;
+    if args.to == Kind::Gcode {
+        return Err(Error::input(
+            "offset writes the toolpath table: post it for a machine with `offset ... | post-6axis --machine M --setup S`, which links the passes (retract, traverse, approach, plunge) and checks the program against the stock and the part",
+        ));
+    }
     if let Some(f) = args.feed {
         positive(f, "--feed")?;
     }
@@ -240,12 +241,7 @@ fn run(args: Args) -> Result<()> {
         cli::warn(w);
     }
     let mut out = Output::new(args.io.output.as_deref());
-    if args.to == Kind::Gcode {
-        let t = with_retracts(&outcome.table, args.clearance);
-        out.buf = camkit::gcode::table_to_program(&t, &name, args.decimals.unwrap_or(4))?;
-    } else {
-        table::write(&mut out, &outcome.table, &WriteOptions { decimals: args.decimals })?;
-    }
+    table::write(&mut out, &outcome.table, &WriteOptions { decimals: args.decimals })?;
     if let Some(path) = &args.svg {
         write_atomic(path, outcome.plot.to_svg(1000.0).as_bytes())?;
     }
@@ -257,18 +253,3 @@ fn run(args: Args) -> Result<()> {
     out.commit()
 }
 
-/// The table with moves between passes made safe for a program: up to the clearance height,
-/// across, and down onto the pass's start at feed.
-fn with_retracts(t: &Table, clearance: f64) -> Table {
-    let top = t.rows.iter().map(|r| r.pos.z).fold(f64::NEG_INFINITY, f64::max) + clearance;
-    let mut rows = Vec::with_capacity(t.rows.len() + 3 * 8);
-    for pass in t.passes() {
-        let first = &pass[0];
-        let above = |r: &Row| Row { mv: Move::Rapid, pos: P3::new(r.pos.x, r.pos.y, top), centre: None, ..r.clone() };
-        rows.push(above(first));
-        rows.push(Row { mv: Move::Line, ..first.clone() });
-        rows.extend(pass[1..].iter().cloned());
-        rows.push(above(&pass[pass.len() - 1]));
-    }
-    Table { schema: t.schema.clone(), rows }
-}
