@@ -252,4 +252,3 @@ fn run(args: Args) -> Result<()> {
     }
     out.commit()
 }
-

@@ -360,7 +360,9 @@ fn collide(
             match (walls.is_some(), solid.is_some()) {
                 (true, _) => "walls".to_string(),
                 (_, true) if so.sampled == 0 => "model: every move cast exactly".to_string(),
-                (_, true) if so.cast == 0 => format!("model: the clearance every {} mm along the moves", job.resolution),
+                (_, true) if so.cast == 0 => {
+                    format!("model: the clearance every {} mm along the moves", job.resolution)
+                }
                 (_, true) => format!(
                     "model: straight moves cast exactly, arcs and turning moves at samples every {} mm",
                     job.resolution

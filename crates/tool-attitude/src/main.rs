@@ -355,21 +355,7 @@ fn run_fixed(args: &Args, tool: &Tool, tool_file: &str, axis: V3, started: Insta
     if let Some(path) = &args.io.report {
         report.write(path)?;
     }
-    if let Some(&k) = gouging.first() {
-        let msg = format!(
-            "{} row(s) gouge the model by more than {} mm (deepest {largest:.6} mm)",
-            gouging.len(),
-            args.gouge_tol
-        );
-        let loc = Location::file(&input.name).line(t.rows[k].line);
-        if !args.allow_gouge {
-            return Err(Error::check(msg).at(loc));
-        }
-        cli::warn(&format!("{loc}: {msg}"));
-    }
-    let mut out = Output::new(args.io.output.as_deref());
-    table::write(&mut out, &t, &WriteOptions { decimals: args.decimals })?;
-    out.commit()
+    deliver(args, &t, &input.name, &gouging, args.gouge_tol, largest)
 }
 
 fn run(args: Args) -> Result<()> {
@@ -499,21 +485,23 @@ fn run(args: Args) -> Result<()> {
     if let Some(path) = &args.io.report {
         report.write(path)?;
     }
+    let largest = poses.iter().filter_map(|a| a.gouge).fold(0.0, f64::max);
+    deliver(&args, &t, &input.name, &gouging, setup.gouge_tol, largest)
+}
+
+/// Writes the table, after rows that gouge (indices `gouging`, the deepest `largest` mm) fail the
+/// run (exit 1, the first row named) or, with --allow-gouge, are warned of.
+fn deliver(args: &Args, t: &Table, input: &str, gouging: &[usize], tol: f64, largest: f64) -> Result<()> {
     if let Some(&k) = gouging.first() {
-        let msg = format!(
-            "{} row(s) gouge the model by more than {} mm even at the best tilt in range (deepest {:.6} mm)",
-            gouging.len(),
-            setup.gouge_tol,
-            poses.iter().filter_map(|a| a.gouge).fold(0.0, f64::max)
-        );
-        let loc = Location::file(&input.name).line(t.rows[k].line);
+        let msg = format!("{} row(s) gouge the model by more than {tol} mm (deepest {largest:.6} mm)", gouging.len());
+        let loc = Location::file(input).line(t.rows[k].line);
         if !args.allow_gouge {
             return Err(Error::check(msg).at(loc));
         }
         cli::warn(&format!("{loc}: {msg}"));
     }
     let mut out = Output::new(args.io.output.as_deref());
-    table::write(&mut out, &t, &WriteOptions { decimals: args.decimals })?;
+    table::write(&mut out, t, &WriteOptions { decimals: args.decimals })?;
     out.commit()
 }
 

@@ -399,22 +399,14 @@ impl Reader<'_> {
                 remark_only,
             }));
         }
-        if program_number(line) {
-            // A Fanuc program number (`O1234`, maybe with a comment): not a block to interpret.
-            return Ok(Block::Other(OtherBlock {
-                line: line_no,
-                span,
-                modes: self.modes,
-                motion_word: false,
-                remark_only: false,
-            }));
-        }
-        if let Some(code) = m_led(line) {
+        let m = m_led(line);
+        if m.is_some() || program_number(line) {
             // An M block (Marlin's M84 X Y E, M117 free text...): its parameters are not
-            // coordinates and need not be numbers. Only the extruder mode is read from it.
-            match code {
-                82 => self.e_mode_relative = false,
-                83 => self.e_mode_relative = true,
+            // coordinates and need not be numbers; only the extruder mode is read from it. A
+            // Fanuc program number (`O1234`, maybe with a comment) is no block to interpret.
+            match m {
+                Some(82) => self.e_mode_relative = false,
+                Some(83) => self.e_mode_relative = true,
                 _ => {}
             }
             self.modes.e_relative = self.e_mode_relative || self.modes.relative;
