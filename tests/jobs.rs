@@ -218,6 +218,21 @@ fn rounded_box(x: f64, y: f64, (cx, cy): (f64, f64), (hx, hy): (f64, f64), r: f6
     qx.max(0.0).hypot(qy.max(0.0)) + qx.max(qy).min(0.0) - r
 }
 
+/// The XY point at fraction `t` of a block (along its arc for G2/G3, the short way from its
+/// start's angle in its direction).
+fn block_point(b: &Block, t: f64) -> (f64, f64) {
+    let Some((c, ccw)) = b.arc else {
+        return (b.from[0] + (b.to[0] - b.from[0]) * t, b.from[1] + (b.to[1] - b.from[1]) * t);
+    };
+    let ang = |p: &[f64; 3]| (p[1] - c[1]).atan2(p[0] - c[0]);
+    let tau = std::f64::consts::TAU;
+    let sweep =
+        if ccw { (ang(&b.to) - ang(&b.from)).rem_euclid(tau) } else { -(ang(&b.from) - ang(&b.to)).rem_euclid(tau) };
+    let r = (b.from[0] - c[0]).hypot(b.from[1] - c[1]);
+    let a = ang(&b.from) + sweep * t;
+    (c[0] + r * a.cos(), c[1] + r * a.sin())
+}
+
 fn report(w: &Work, name: &str) -> serde_json::Value {
     serde_json::from_str(&w.read(name)).expect("report JSON")
 }
@@ -245,6 +260,44 @@ fn an_island_pocket_posted_with_a_setup_has_no_unsafe_rapid() {
     let found = unsafe_rapids(&naive);
     assert!(found.len() >= 7, "{found:?}");
     assert!(found.iter().any(|(_, why)| why.contains("into the walls or an island")), "{found:?}");
+}
+
+/// The island pocket with lead arcs (R3) and 3° ramps: the slots and the octagon entered and left
+/// along tangent arcs on the side away from the part (the octagon round the island leads
+/// outwards: inwards would come 0.12 mm into it); the wall passes, which start and end in a
+/// corner touching two walls, have room for neither (counted, not cut); every feed move, arcs
+/// sampled, keeps R from the walls and the island, and every G0 stays safe.
+#[test]
+fn lead_arcs_keep_clear_of_the_part() {
+    let w = job();
+    let m = machine();
+    w.write(
+        "lead.json",
+        SETUP.replace(
+            r#""approach": 1"#,
+            r#""approach": 1, "lead": {"radius": 3}, "plunge": {"feed": 150, "ramp_angle": 3}"#,
+        ),
+    );
+    w.run(BIN, &["passes.csv", "--machine", &m, "--setup", "lead.json", "--report", "r.json", "-o", "p.ngc"], b"").ok();
+    let nc = w.read("p.ngc");
+    let r = report(&w, "r.json");
+    assert_eq!(
+        (r["lead_ins"].as_u64(), r["lead_outs"].as_u64(), r["leads_not_clear"].as_u64()),
+        (Some(6), Some(6), Some(4)),
+        "{r}"
+    );
+    assert_eq!((r["rapids_into_material"].as_u64(), r["part_collisions"].as_u64()), (Some(0), Some(0)), "{r}");
+    assert_eq!(unsafe_rapids(&nc), vec![], "{nc}");
+    let part =
+        |x: f64, y: f64| ((x - ISLAND.0).hypot(y - ISLAND.1) - ISLAND.2).min(x.min(100.0 - x).min(y).min(60.0 - y));
+    let bs = blocks(&nc);
+    assert!(bs.iter().filter(|b| b.arc.is_some()).count() >= 16, "{nc}");
+    for b in bs.iter().filter(|b| !b.rapid && b.to[2] < 0.0) {
+        for k in 0..=32 {
+            let (x, y) = block_point(b, k as f64 / 32.0);
+            assert!(part(x, y) >= R - 1e-3, "line {}: ({x}, {y}) is {} from the part", b.line, part(x, y));
+        }
+    }
 }
 
 /// The post's own check names the first unsafe G0 of a program by its NC line, and writes its

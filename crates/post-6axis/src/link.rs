@@ -17,7 +17,7 @@ use camkit::collide::walls::{Column, Walls};
 use camkit::contour::Seg;
 use camkit::doc::Job;
 use camkit::error::{Error, Location, Result};
-use camkit::geom::{P2, P3, V3};
+use camkit::geom::{P2, P3, Plane, V2, V3};
 
 /// The most nodes the material map may have (about 160 MB).
 pub const MAX_NODES: usize = 20_000_000;
@@ -51,6 +51,12 @@ pub struct Stats {
     pub ramps: usize,
     /// Pass starts reached by rapid alone (already above the material by the approach).
     pub direct: usize,
+    /// Lead-in arcs made.
+    pub lead_ins: usize,
+    /// Lead-out arcs made.
+    pub lead_outs: usize,
+    /// Lead arcs left out because neither side kept clear of the part.
+    pub leads_not_clear: usize,
 }
 
 /// The linked rows.
@@ -87,7 +93,7 @@ fn vertical(axis: &V3) -> bool {
 pub fn cut_pieces(prev: &P3, row: &Cl) -> Vec<(Seg, f64, f64)> {
     match &row.arc {
         None => vec![(Seg::Line(xy(prev), xy(&row.tip)), prev.z, row.tip.z)],
-        Some(arc) if arc.plane == camkit::geom::Plane::Xy => {
+        Some(arc) if arc.plane == Plane::Xy => {
             let (a, _, _) = arc.in_plane(prev, &row.tip);
             vec![(Seg::Arc(a), prev.z, row.tip.z)]
         }
@@ -106,6 +112,40 @@ pub fn cut_pieces(prev: &P3, row: &Cl) -> Vec<(Seg, f64, f64)> {
                 .collect()
         }
     }
+}
+
+/// The unit XY direction of travel of the move from `prev` to `row` at its start (`at_end`: at
+/// its end), if the move is a level line or XY arc of some length.
+fn level_direction(prev: &P3, row: &Cl, at_end: bool) -> Option<V2> {
+    if (row.tip.z - prev.z).abs() > 1e-9 {
+        return None;
+    }
+    match &row.arc {
+        None => {
+            let d = xy(&row.tip) - xy(prev);
+            (d.norm() > 1e-9).then(|| d.normalize())
+        }
+        Some(arc) if arc.plane == Plane::Xy => {
+            let (a, _, _) = arc.in_plane(prev, &row.tip);
+            (a.length() > 1e-9).then(|| a.tangent_at(if at_end { a.start + a.sweep } else { a.start }))
+        }
+        Some(_) => None,
+    }
+}
+
+/// The lead arc of radius `r` and sweep `angle` (radians) tangent to direction `d` at `p`, its
+/// centre on the left of `d` if `left`: arriving at `p` if `into`, else leaving it. Returns the
+/// arc's other end (at `p`'s height) and the arc as it is run.
+pub fn lead_arc(p: &P3, d: &V2, r: f64, angle: f64, left: bool, into: bool) -> (P3, ClArc) {
+    let side = if left { 1.0 } else { -1.0 };
+    let centre = xy(p) + V2::new(-d.y, d.x) * (side * r);
+    // Turning about the centre: counter-clockwise with the centre on the left; back from `p` for
+    // a lead-in.
+    let turn = side * if into { -angle } else { angle };
+    let v = xy(p) - centre;
+    let (s, c) = turn.sin_cos();
+    let q = centre + V2::new(c * v.x - s * v.y, s * v.x + c * v.y);
+    (P3::new(q.x, q.y, p.z), ClArc { plane: Plane::Xy, centre, ccw: left })
 }
 
 /// Sagitta of the chords that stand for an arc outside the XY plane on the material map (mm):
@@ -230,8 +270,7 @@ impl<'a> Linker<'a> {
         let mut length = 0.0;
         let mut from = start.tip;
         for row in rest.iter().take(RAMP_ROWS).take_while(|n| !n.rapid && vertical(&n.axis)) {
-            let level =
-                (row.tip.z - start.tip.z).abs() <= 1e-9 && row.arc.is_none_or(|a| a.plane == camkit::geom::Plane::Xy);
+            let level = (row.tip.z - start.tip.z).abs() <= 1e-9 && row.arc.is_none_or(|a| a.plane == Plane::Xy);
             if !level || length >= want {
                 break;
             }
@@ -372,6 +411,75 @@ impl<'a> Linker<'a> {
         self.out.push(Cl { rapid: false, reorient: false, ..*row });
     }
 
+    /// The vertical tool body measured against the part's walls.
+    fn column(&self) -> Column {
+        Column {
+            radius: self.cutter.radius,
+            length: self.job.tool.length.unwrap_or(6.0 * self.cutter.radius),
+            holder_radius: 0.0,
+        }
+    }
+
+    /// Smallest clearance from the part (walls or model) of the tool running the arc from `a` to
+    /// `b` (+∞ where the setup names no part).
+    fn arc_clearance(&self, a: &P3, b: &P3, arc: &ClArc) -> f64 {
+        let mut least = f64::INFINITY;
+        if let Some(walls) = self.walls {
+            let (a2, _, _) = arc.in_plane(a, b);
+            least = least.min(walls.clearance(&self.column(), &Seg::Arc(a2), a.z, b.z).mm);
+        }
+        if let Some((solid, body)) = self.solid {
+            let (a2, _, _) = arc.in_plane(a, b);
+            let n = ((a2.length() / self.job.resolution).ceil() as usize).clamp(2, 10_000);
+            for k in 0..=n {
+                let tip = arc.point(a, b, k as f64 / n as f64);
+                least = least.min(solid.clearance(body, &Placement { tip, axis: V3::z(), edge: None }, 1.0));
+            }
+        }
+        least
+    }
+
+    /// The lead arc at `p` along `d` (left, climb milling's side away from the wall, if it keeps
+    /// clear of the part, else right), if the setup asks for leads and a side is clear: its other
+    /// end and the arc.
+    fn lead(&mut self, p: &P3, d: &V2, into: bool) -> Option<(P3, ClArc)> {
+        let lead = self.job.lead?;
+        let least = self.job.allowance - self.job.tolerance;
+        for left in [true, false] {
+            let (q, arc) = lead_arc(p, d, lead.radius, lead.angle.to_radians(), left, into);
+            let (a, b) = if into { (q, *p) } else { (*p, q) };
+            if self.arc_clearance(&a, &b, &arc) >= least {
+                return Some((q, arc));
+            }
+        }
+        self.stats.leads_not_clear += 1;
+        None
+    }
+
+    /// The lead-in to the pass that starts with `start` and goes on with `next`: a start row at
+    /// the arc's far end and the arc to `start`, for a vertical tool on a level first move.
+    fn lead_in(&mut self, start: &Cl, next: Option<&Cl>) -> Option<(Cl, Cl)> {
+        let next = next.filter(|n| !n.rapid && vertical(&n.axis) && vertical(&start.axis))?;
+        let d = level_direction(&start.tip, next, false)?;
+        let (q, arc) = self.lead(&start.tip, &d, true)?;
+        self.stats.lead_ins += 1;
+        let feed = next.feed.or(start.feed);
+        Some((Cl { tip: q, ..*start }, Cl { feed, rapid: false, reorient: false, arc: Some(arc), ..*start }))
+    }
+
+    /// The lead-out from the pass just written, if its last move is level with a vertical tool.
+    fn lead_out(&mut self) {
+        let [.., prev, end] = self.out[..] else { return };
+        if prev.rapid || end.rapid || !vertical(&end.axis) || !vertical(&prev.axis) {
+            return;
+        }
+        let Some(d) = level_direction(&prev.tip, &end, true) else { return };
+        if let Some((q, arc)) = self.lead(&end.tip, &d, false) {
+            self.stats.lead_outs += 1;
+            self.feed(&Cl { tip: q, arc: Some(arc), ..end });
+        }
+    }
+
     /// Refuses rows that cut outside the stock: below its bottom, or beyond its outline by more
     /// than the tool radius.
     fn inside(&self, rows: &[Cl]) -> Result<()> {
@@ -422,11 +530,7 @@ impl<'a> Linker<'a> {
             }
         }
         let Some(walls) = self.walls else { return Ok(()) };
-        let column = Column {
-            radius: self.cutter.radius,
-            length: self.job.tool.length.unwrap_or(6.0 * self.cutter.radius),
-            holder_radius: 0.0,
-        };
+        let column = self.column();
         for row in rows.iter().filter(|r| r.rapid && vertical(&r.axis)) {
             let p = xy(&row.tip);
             let c = walls.clearance(&column, &Seg::Line(p, p), row.tip.z, row.tip.z).mm;
@@ -449,10 +553,25 @@ impl<'a> Linker<'a> {
         self.reachable(rows)?;
         for (i, row) in rows.iter().enumerate() {
             if row.rapid || self.out.is_empty() {
-                self.link_to(row, &rows[i + 1..])?;
+                if i > 0 {
+                    self.lead_out();
+                }
+                match self.lead_in(row, rows.get(i + 1)) {
+                    Some((start, arc)) => {
+                        // The ramp, if any, runs along the lead-in and on into the pass.
+                        let rest: Vec<Cl> =
+                            std::iter::once(arc).chain(rows[i + 1..].iter().take(RAMP_ROWS).copied()).collect();
+                        self.link_to(&start, &rest)?;
+                        self.feed(&arc);
+                    }
+                    None => self.link_to(row, &rows[i + 1..])?,
+                }
             } else {
                 self.feed(row);
             }
+        }
+        if !rows.is_empty() {
+            self.lead_out();
         }
         if let Some(end) = self.out.last().copied() {
             let up = Self::up_to(&end.tip, &end.axis, self.job.clearance_height);
@@ -589,6 +708,86 @@ mod tests {
             assert!(drop > 0.0 && (drop - run * tan).abs() < 1e-9, "{:?} {:?}", w[0].tip, w[1].tip);
             assert!(w[1].tip.y == 10.0 || w[1].tip.x == 20.0, "off the pass: {:?}", w[1].tip);
             assert_eq!(w[1].feed, Some(200.0));
+        }
+    }
+
+    /// Lead arcs of R3 into and out of a level slot along +X, with no part named: on the left,
+    /// quarter circles tangent to the slot, the plunge at the lead-in's start.
+    #[test]
+    fn lead_arcs_enter_and_leave_a_level_pass_tangentially() {
+        let mut j = job(0.0, 5.0, None);
+        j.lead = Some(Lead { radius: 3.0, angle: 90.0 });
+        let rows = [cl(10.0, 10.0, -5.0, true), cl(90.0, 10.0, -5.0, false)];
+        let l = Linker::new(&j, None, None, "t.csv").unwrap().link(&rows).unwrap();
+        let got: Vec<(P3, bool, Option<ClArc>)> = l.rows.iter().map(|r| (r.tip, r.rapid, r.arc)).collect();
+        let ccw = |x: f64, y: f64| Some(ClArc { plane: Plane::Xy, centre: P2::new(x, y), ccw: true });
+        let want = vec![
+            (P3::new(7.0, 13.0, 30.0), true, None),
+            (P3::new(7.0, 13.0, 1.0), true, None),
+            (P3::new(7.0, 13.0, -5.0), false, None),
+            (P3::new(10.0, 10.0, -5.0), false, ccw(10.0, 13.0)),
+            (P3::new(90.0, 10.0, -5.0), false, None),
+            (P3::new(93.0, 13.0, -5.0), false, ccw(90.0, 13.0)),
+            (P3::new(93.0, 13.0, 30.0), true, None),
+        ];
+        assert_eq!(got.len(), want.len(), "{got:?}");
+        for (g, w) in got.iter().zip(&want) {
+            assert!((g.0 - w.0).norm() < 1e-12 && g.1 == w.1, "{g:?} != {w:?}");
+            assert_eq!(g.2.map(|a| a.ccw), w.2.map(|a| a.ccw));
+            if let (Some(a), Some(b)) = (g.2, w.2) {
+                assert!((a.centre - b.centre).norm() < 1e-12, "{g:?}");
+            }
+        }
+        assert_eq!(l.rows[3].feed, Some(800.0), "the lead-in at the pass's feed");
+        assert_eq!((l.stats.lead_ins, l.stats.lead_outs, l.stats.leads_not_clear), (1, 1, 0));
+    }
+
+    /// A slot along a wall on its left: the leads go right, away from the wall; a slot between
+    /// two walls too near for either side gets none, and says so.
+    #[test]
+    fn lead_arcs_keep_to_the_side_clear_of_the_walls() {
+        use camkit::contour::Contour;
+        use camkit::contour::region::regions;
+        let pocket = |h: f64| {
+            let outer =
+                Contour::polygon(&[P2::new(0.0, 0.0), P2::new(100.0, 0.0), P2::new(100.0, h), P2::new(0.0, h)], true);
+            let (r, _) = regions(&[outer]).unwrap();
+            Walls::new(&r, -12.0, 0.0, 10.0)
+        };
+        let mut j = job(0.0, 5.0, None);
+        j.lead = Some(Lead { radius: 3.0, angle: 90.0 });
+        // The wall y = 20 is 4 mm (R) to the slot's left.
+        let walls = pocket(20.0);
+        let rows = [cl(10.0, 16.0, -5.0, true), cl(90.0, 16.0, -5.0, false)];
+        let l = Linker::new(&j, Some(&walls), None, "t.csv").unwrap().link(&rows).unwrap();
+        let arcs: Vec<&Cl> = l.rows.iter().filter(|r| r.arc.is_some()).collect();
+        assert_eq!(arcs.len(), 2);
+        assert!(arcs.iter().all(|r| !r.arc.unwrap().ccw && r.arc.unwrap().centre.y == 13.0), "{arcs:?}");
+        assert!(l.rows.iter().all(|r| r.tip.y <= 16.0 + 1e-12), "{:?}", l.rows);
+        // A slot 8 mm wide (the tool's width): no room for a lead on either side.
+        let walls = pocket(8.0);
+        let rows = [cl(10.0, 4.0, -5.0, true), cl(90.0, 4.0, -5.0, false)];
+        let l = Linker::new(&j, Some(&walls), None, "t.csv").unwrap().link(&rows).unwrap();
+        assert!(l.rows.iter().all(|r| r.arc.is_none()));
+        assert_eq!((l.stats.lead_ins, l.stats.lead_outs, l.stats.leads_not_clear), (0, 0, 2));
+    }
+
+    proptest::proptest! {
+        /// A lead arc has the lead's radius and sweep, meets the pass at its point with the pass's
+        /// direction, and has its centre on the side asked for.
+        #[test]
+        fn lead_arcs_are_tangent(a in 0.0..std::f64::consts::TAU, r in 0.1..20.0f64, sweep in 1.0..180.0f64,
+                                 left: bool, into: bool) {
+            let (p, d) = (P3::new(3.0, -2.0, -4.0), V2::new(a.cos(), a.sin()));
+            let (q, arc) = lead_arc(&p, &d, r, sweep.to_radians(), left, into);
+            let (from, to) = if into { (q, p) } else { (p, q) };
+            let (a2, w0, w1) = arc.in_plane(&from, &to);
+            proptest::prop_assert!((a2.r - r).abs() < 1e-9 && w0 == -4.0 && w1 == -4.0);
+            proptest::prop_assert!((a2.sweep.abs() - sweep.to_radians()).abs() < 1e-9);
+            let t = a2.tangent_at(if into { a2.start + a2.sweep } else { a2.start });
+            proptest::prop_assert!((t - d).norm() < 1e-9, "tangent {t:?} vs {d:?}");
+            let c = a2.c - xy(&p);
+            proptest::prop_assert!((d.x * c.y - d.y * c.x > 0.0) == left);
         }
     }
 

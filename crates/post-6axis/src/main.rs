@@ -65,8 +65,8 @@ struct Args {
     /// INPUT is an NC program: write it back as the toolpath table.
     #[arg(long)]
     reverse: bool,
-    /// The job's setup document (JSON: stock, part, heights, plunge, tool): the passes are linked
-    /// (retract, traverse, approach, plunge), the header takes the tool's number, spindle speed
+    /// The job's setup document (JSON: stock, part, heights, plunge, leads, tool): the passes are
+    /// linked (retract, traverse, approach, plunge or ramp, lead arcs), the header takes the tool's number, spindle speed
     /// and feeds, and the written program is checked for collisions before it is delivered.
     #[arg(long, value_name = "FILE")]
     setup: Option<String>,
@@ -273,7 +273,10 @@ fn link_keys(report: &mut Report, s: &link::Stats) {
         .set("plunges", s.plunges)
         .set("plunge_mm", s.plunge_mm)
         .set("ramps", s.ramps)
-        .set("starts_reached_by_rapid", s.direct);
+        .set("starts_reached_by_rapid", s.direct)
+        .set("lead_ins", s.lead_ins)
+        .set("lead_outs", s.lead_outs)
+        .set("leads_not_clear", s.leads_not_clear);
 }
 
 /// Runs the collision check on the written program; a program that fails it is not delivered
