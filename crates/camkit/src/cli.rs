@@ -16,9 +16,14 @@ pub fn program() -> &'static str {
 
 /// Runs a filter's body: errors become one line on stderr (`name: file:line:col (field): what`)
 /// and the exit status of their kind; a closed output pipe ends quietly with status 0; a panic
-/// (a bug) prints one line, not a backtrace.
+/// (a bug) prints one line, not a backtrace; an interrupt (SIGINT, SIGTERM, SIGHUP) removes the
+/// output file being written and exits with 130.
 pub fn run(name: &'static str, body: impl FnOnce() -> Result<()>) -> ExitCode {
     let _ = PROGRAM.set(name);
+    let _ = ctrlc::set_handler(|| {
+        crate::io::remove_pending();
+        std::process::exit(130);
+    });
     std::panic::set_hook(Box::new(|info| {
         let place = info.location().map(|l| format!(" at {}:{}", l.file(), l.line())).unwrap_or_default();
         let what = info
@@ -33,11 +38,17 @@ pub fn run(name: &'static str, body: impl FnOnce() -> Result<()>) -> ExitCode {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
             if e.kind != crate::error::ErrorKind::BrokenPipe {
-                eprintln!("{name}: {e}");
+                eprintln!("{name}: {}", printable(&e.to_string()));
             }
             ExitCode::from(e.exit_status() as u8)
         }
     }
+}
+
+/// `text` with control characters from the input (a CR, a NUL, an escape) shown as escapes, so
+/// that a message stays one line and prints nothing raw to the terminal.
+pub fn printable(text: &str) -> String {
+    text.chars().flat_map(|c| if c.is_control() { c.escape_default().collect::<Vec<_>>() } else { vec![c] }).collect()
 }
 
 /// A command-line number that must be finite and above zero (`what` names the option): usage
@@ -78,7 +89,7 @@ impl Kind {
 
 /// Prints a warning on stderr (`name: warning: ...`).
 pub fn warn(message: &str) {
-    eprintln!("{}: warning: {message}", program());
+    eprintln!("{}: warning: {}", program(), printable(message));
 }
 
 /// Arguments every filter takes: input, `-o`, `--report`.

@@ -129,7 +129,12 @@ impl Error {
             return Error { kind: ErrorKind::BrokenPipe, location: None, message: "broken pipe".into() };
         }
         let kind = match err.kind() {
-            std::io::ErrorKind::NotFound | std::io::ErrorKind::PermissionDenied => ErrorKind::Input,
+            // A path the user gave that cannot be a file: bad input, not a failure of the run.
+            std::io::ErrorKind::NotFound
+            | std::io::ErrorKind::PermissionDenied
+            | std::io::ErrorKind::IsADirectory
+            | std::io::ErrorKind::NotADirectory
+            | std::io::ErrorKind::InvalidFilename => ErrorKind::Input,
             _ => ErrorKind::Runtime,
         };
         Error { kind, location: None, message: format!("{what}: {}", plain_io_message(&err)) }

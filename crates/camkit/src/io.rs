@@ -3,6 +3,22 @@
 use crate::error::{Error, Result};
 use std::io::{Read, Write};
 use std::path::{Path, PathBuf};
+use std::sync::Mutex;
+
+/// The temporary file an output is being written to, if any: an interrupt removes it (see
+/// [`remove_pending`]), so that a run stopped while committing leaves nothing behind.
+static PENDING: Mutex<Option<PathBuf>> = Mutex::new(None);
+
+/// Removes the output file being written, if any, and keeps any other commit from starting:
+/// for the interrupt handler ([`crate::cli::run`]), which exits right after.
+pub fn remove_pending() {
+    let guard = PENDING.lock().unwrap_or_else(|e| e.into_inner());
+    if let Some(path) = guard.as_ref() {
+        let _ = std::fs::remove_file(path);
+    }
+    // Held until the process exits: a commit cannot rename the file into place meanwhile.
+    std::mem::forget(guard);
+}
 
 /// A whole input, read into memory, with the name errors should show.
 #[derive(Clone, Debug)]
@@ -93,26 +109,58 @@ impl Write for Output {
 }
 
 /// Writes `data` to `path` through a temporary file in the same directory, renamed into place,
-/// so readers see the old file or the whole new one.
+/// so readers see the old file or the whole new one. A symbolic link is followed (its target is
+/// replaced, the link kept); a new file gets the usual mode under the umask, a replaced one keeps
+/// its mode.
 pub fn write_atomic(path: &Path, data: &[u8]) -> Result<()> {
     let shown = path.display().to_string();
+    let cannot = |e: std::io::Error| Error::io(e, &format!("cannot write {shown}"));
+    let path = &follow_links(path).map_err(cannot)?;
     // A device or pipe (`-o /dev/null`, a FIFO) is written in place: renaming over it would
     // replace the device with a regular file.
-    if std::fs::metadata(path).is_ok_and(|m| !m.is_file() && !m.is_dir()) {
+    let existing = std::fs::metadata(path).ok();
+    if existing.as_ref().is_some_and(|m| !m.is_file() && !m.is_dir()) {
         return std::fs::write(path, data).map_err(|e| Error::io(e, &shown));
     }
     let dir = match path.parent() {
         Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
         _ => PathBuf::from("."),
     };
+    use std::os::unix::fs::PermissionsExt;
     let mut tmp = tempfile::Builder::new()
         .prefix(".camkit-")
         .suffix(".tmp")
+        .permissions(std::fs::Permissions::from_mode(0o666))
         .tempfile_in(&dir)
-        .map_err(|e| Error::io(e, &format!("cannot write {shown}")))?;
-    tmp.write_all(data).and_then(|_| tmp.flush()).map_err(|e| Error::io(e, &format!("cannot write {shown}")))?;
-    tmp.persist(path).map_err(|e| Error::io(e.error, &format!("cannot write {shown}")))?;
+        .map_err(cannot)?;
+    *PENDING.lock().unwrap_or_else(|e| e.into_inner()) = Some(tmp.path().to_path_buf());
+    let written = tmp.write_all(data).and_then(|_| tmp.flush());
+    let mut pending = PENDING.lock().unwrap_or_else(|e| e.into_inner());
+    *pending = None;
+    written.map_err(cannot)?;
+    if let Some(m) = existing {
+        tmp.as_file().set_permissions(m.permissions()).map_err(cannot)?;
+    }
+    tmp.persist(path).map_err(|e| cannot(e.error))?;
     Ok(())
+}
+
+/// `path` with symbolic links followed to the file they name (which need not exist yet).
+fn follow_links(path: &Path) -> std::io::Result<PathBuf> {
+    let mut path = path.to_path_buf();
+    for _ in 0..40 {
+        match std::fs::symlink_metadata(&path) {
+            Ok(m) if m.file_type().is_symlink() => {
+                let target = std::fs::read_link(&path)?;
+                path = match path.parent() {
+                    Some(dir) if target.is_relative() => dir.join(target),
+                    _ => target,
+                };
+            }
+            _ => return Ok(path),
+        }
+    }
+    Err(std::io::Error::other("too many levels of symbolic links"))
 }
 
 #[cfg(test)]

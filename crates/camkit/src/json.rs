@@ -8,6 +8,8 @@ use serde::de::DeserializeOwned;
 /// Parses a JSON document of type `T` from an input.
 pub fn from_input<T: DeserializeOwned>(input: &Input) -> Result<T> {
     let text = input.text()?;
+    // A byte order mark some editors put first is not part of the document.
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     if text.trim().is_empty() {
         return Err(Error::input("empty input: expected a JSON document").at(Location::file(&input.name)));
     }

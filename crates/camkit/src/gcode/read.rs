@@ -24,6 +24,10 @@ struct Word {
     end: usize,
 }
 
+/// How far apart (mm) an arc's start and end radii may be, as LinuxCNC allows (0.002 inch), when
+/// they also differ by more than 0.1 %.
+const ARC_RADIUS_SLACK_MM: f64 = 0.0508;
+
 /// Exact powers of ten.
 const POW10: [f64; 23] = [
     1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11, 1e12, 1e13, 1e14, 1e15, 1e16, 1e17, 1e18, 1e19, 1e20,
@@ -150,7 +154,8 @@ impl<'a> Blocks<'a> {
                 e_abs: None,
             },
             bytes: source.as_bytes(),
-            line_start: 0,
+            // A byte order mark some editors put first is not part of the program.
+            line_start: if source.starts_with('\u{feff}') { 3 } else { 0 },
             line_no: 0,
             words: Vec::with_capacity(16),
             decimals: Decimals::default(),
@@ -272,6 +277,10 @@ impl Reader<'_> {
                             "malformed word: a letter must be followed by a number",
                         ));
                     };
+                    if !value.is_finite() {
+                        let shown = &line[i..end.min(i + 24)];
+                        return Err(self.err(line_no, i, shown, "number out of range (beyond ±1.8e308)"));
+                    }
                     if let Some(&next) = line.get(end)
                         && !(next.is_ascii_alphabetic() || matches!(next, b' ' | b'\t' | b'(' | b';' | b'*'))
                     {
@@ -583,8 +592,30 @@ impl Reader<'_> {
             let side = if (motion == Motion::Ccw) == (radius > 0.0) { 1.0 } else { -1.0 };
             return Ok(P2::from((s.coords + e.coords) * 0.5) + left * (side * h));
         }
+        if ijk[u].is_none() && ijk[v].is_none() {
+            let text = String::from_utf8_lossy(line);
+            return Err(self.err(
+                line_no,
+                0,
+                text.trim().as_bytes(),
+                "an arc needs its centre (I, J, K in its plane) or R",
+            ));
+        }
         let off = |axis: usize| ijk[axis].unwrap_or(0.0);
-        Ok(if self.modes.absolute_arc_centres { P2::new(off(u), off(v)) } else { P2::new(s.x + off(u), s.y + off(v)) })
+        let c =
+            if self.modes.absolute_arc_centres { P2::new(off(u), off(v)) } else { P2::new(s.x + off(u), s.y + off(v)) };
+        // LinuxCNC's rule: the ends may lie at radii differing by 0.05 mm or 0.1 % of the radius.
+        let (r0, r1) = ((s - c).norm(), (e - c).norm());
+        if (r0 - r1).abs() > ARC_RADIUS_SLACK_MM && (r0 - r1).abs() > 1e-3 * r0.max(r1) {
+            let text = String::from_utf8_lossy(line);
+            return Err(self.err(
+                line_no,
+                0,
+                text.trim().as_bytes(),
+                &format!("the arc's ends are not on one circle about its centre: radii {r0:.6} and {r1:.6} mm"),
+            ));
+        }
+        Ok(c)
     }
 }
 

@@ -147,7 +147,8 @@ impl Mesh {
 /// Reads an STL file (binary or ASCII) into corner triples. Empty, truncated and malformed files
 /// and non-finite coordinates are input errors naming the facet (and its line in ASCII files).
 pub fn read_stl(input: &Input) -> Result<Vec<[P3; 3]>> {
-    let data = &input.data;
+    // A byte order mark some editors put before an ASCII file's `solid` is not part of it.
+    let data = input.data.strip_prefix(b"\xef\xbb\xbf").unwrap_or(&input.data);
     let here = || Location::file(&input.name);
     if data.iter().all(|b| b.is_ascii_whitespace()) {
         return Err(Error::input("empty STL file").at(here()));
@@ -159,7 +160,7 @@ pub fn read_stl(input: &Input) -> Result<Vec<[P3; 3]>> {
     // Binary files whose 80-byte header happens to start with "solid" are common: the size
     // decides. stl_io probes by the word, so such a header is blanked before it reads.
     let ascii = starts_solid && !binary_fits;
-    let mut bytes = std::borrow::Cow::Borrowed(data.as_slice());
+    let mut bytes = std::borrow::Cow::Borrowed(data);
     if !ascii {
         let Some(n) = binary_count else {
             return Err(
@@ -174,16 +175,36 @@ pub fn read_stl(input: &Input) -> Result<Vec<[P3; 3]>> {
             ))
             .at(here()));
         }
-        if starts_solid {
-            let mut owned = data.clone();
-            owned[..6].copy_from_slice(b"binary");
+        if data.len() > 84 + 50 * n {
+            // More triangles than the header says (a writer that did not go back to count): the
+            // size tells how many when it is whole records, else the file is not to be trusted.
+            let extra = data.len() - 84 - 50 * n;
+            if extra % 50 != 0 {
+                return Err(Error::input(format!(
+                    "binary STL of {} bytes: the header announces {n} triangles ({} bytes), and the rest is not whole triangles ({} bytes over)",
+                    data.len(),
+                    84 + 50 * n,
+                    extra % 50
+                ))
+                .at(here()));
+            }
+            let m = (data.len() - 84) / 50;
+            crate::cli::warn(&format!(
+                "{}: the binary STL header announces {n} triangles but the file holds {m}: all {m} are read",
+                input.name
+            ));
+            let mut owned = data.to_vec();
+            owned[80..84].copy_from_slice(&(m as u32).to_le_bytes());
             bytes = std::borrow::Cow::Owned(owned);
+        }
+        if starts_solid {
+            bytes.to_mut()[..6].copy_from_slice(b"binary");
         }
     }
     let mut cursor = std::io::Cursor::new(bytes.as_ref());
     let reader =
         stl_io::create_stl_reader(&mut cursor).map_err(|e| Error::input(format!("not an STL file: {e}")).at(here()))?;
-    let mut out = Vec::with_capacity(binary_count.unwrap_or(0).min(50_000_000));
+    let mut out = Vec::with_capacity(((data.len().saturating_sub(84)) / 50).min(50_000_000));
     for (k, tri) in reader.enumerate() {
         let facet_at = |k: usize| {
             let loc = here().field(format!("facet {}", k + 1));
@@ -310,5 +331,25 @@ mod tests {
         let flat = vec![[P3::origin(), P3::new(1.0, 0.0, 0.0), P3::new(2.0, 0.0, 0.0)]];
         let e = load_stl(&input("d.stl", binary_stl(&flat))).unwrap_err();
         assert!(e.to_string().starts_with("d.stl (facet 1): degenerate triangle"), "{e}");
+    }
+
+    /// A header that counts fewer triangles than the file holds: all are read; bytes after them
+    /// that are no whole triangle are refused. An ASCII file after a byte order mark is ASCII.
+    #[test]
+    fn stl_count_below_the_data_and_a_bom() {
+        let tris = field(3);
+        let mut low = binary_stl(&tris);
+        low[80..84].copy_from_slice(&5u32.to_le_bytes());
+        let whole = read_stl(&input("all.stl", binary_stl(&tris))).unwrap();
+        assert_eq!((whole.len(), read_stl(&input("low.stl", low.clone())).unwrap()), (18, whole));
+        low.extend_from_slice(&[0; 7]);
+        let e = read_stl(&input("low.stl", low)).unwrap_err();
+        assert!(
+            e.to_string()
+                .contains("announces 5 triangles (334 bytes), and the rest is not whole triangles (7 bytes over)"),
+            "{e}"
+        );
+        let ascii = "\u{feff}solid t\nfacet normal 0 0 1\n outer loop\n  vertex 0 0 0\n  vertex 1 0 0\n  vertex 0 1 0\n endloop\nendfacet\nendsolid t\n";
+        assert_eq!(read_stl(&input("bom.stl", ascii.as_bytes().to_vec())).unwrap().len(), 1);
     }
 }

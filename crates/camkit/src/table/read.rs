@@ -21,13 +21,11 @@ impl Layout {
 
 /// Reads a whole table from `input`. `required` columns must be in the header.
 pub fn read(input: &Input, required: &[Col]) -> Result<Table> {
-    let mut reader = csv::ReaderBuilder::new()
-        .comment(Some(b'#'))
-        .trim(csv::Trim::All)
-        .flexible(false)
-        .from_reader(input.data.as_slice());
+    let data = normalise(&input.data);
+    let mut reader =
+        csv::ReaderBuilder::new().comment(Some(b'#')).trim(csv::Trim::All).flexible(false).from_reader(&data[..]);
     let loc = |line: u64| Location::file(&input.name).line(line);
-    let mut lines = LineCounter { data: &input.data, byte: 0, line: 1 };
+    let mut lines = LineCounter { data: &data, byte: 0, line: 1 };
     let header = reader.byte_headers().map_err(|e| csv_error(e, &input.name, &mut lines))?.clone();
     if header.is_empty() || header.iter().all(|h| h.is_empty()) {
         return Err(Error::input("empty input: expected a header row naming the columns (e.g. x,y,z)")
@@ -52,6 +50,30 @@ pub fn read(input: &Input, required: &[Col]) -> Result<Table> {
         rows.push(parse_row(&record, &layout, &schema, &input.name, line)?);
     }
     Ok(Table { schema, rows })
+}
+
+/// The text with old Mac line ends (a lone CR) made LF and lines of only spaces and tabs made
+/// comments, byte for byte, so that the csv reader skips them as it skips empty lines and offsets
+/// stay those of the input. Borrowed when there is nothing to change.
+fn normalise(data: &[u8]) -> std::borrow::Cow<'_, [u8]> {
+    let lone_cr = |k: usize| data[k] == b'\r' && data.get(k + 1) != Some(&b'\n');
+    let blank_at = |k: usize| {
+        let rest = &data[k..];
+        let n = rest.iter().take_while(|b| matches!(b, b' ' | b'\t')).count();
+        n > 0 && matches!(rest.get(n), None | Some(b'\n' | b'\r'))
+    };
+    let starts = || std::iter::once(0).chain(memchr::memchr2_iter(b'\n', b'\r', data).map(|k| k + 1));
+    if !memchr::memchr_iter(b'\r', data).any(lone_cr) && !starts().any(|k| k < data.len() && blank_at(k)) {
+        return std::borrow::Cow::Borrowed(data);
+    }
+    let mut out = data.to_vec();
+    for k in memchr::memchr_iter(b'\r', data).filter(|&k| lone_cr(k)) {
+        out[k] = b'\n';
+    }
+    for k in starts().filter(|&k| k < data.len() && blank_at(k)) {
+        out[k] = b'#';
+    }
+    std::borrow::Cow::Owned(out)
 }
 
 /// Line numbers from byte offsets (the csv crate does not count `#` comment lines).
@@ -298,6 +320,20 @@ mod tests {
         assert!(e.to_string().starts_with("in.csv: empty input"), "{e}");
         let e = read(&input("x,y\n# note\n1,2,3\n"), &[Col::X]).unwrap_err();
         assert_eq!(e.to_string(), "in.csv:3: expected 2 fields like the header, found 3");
+    }
+
+    /// Lines of spaces are skipped like empty ones, old Mac line ends (CR alone) read like LF
+    /// after a comment too, a BOM is dropped; line numbers stay those of the text.
+    #[test]
+    fn blank_lines_lone_cr_and_bom() {
+        let t = read(&input("x,y\n0,0\n   \n\t\n1,1\n"), &[Col::X, Col::Y]).unwrap();
+        assert_eq!((t.rows.len(), t.rows[1].line), (2, 5));
+        let t = read(&input("# a sine\rx,y\r0,0\r  \r1,2\r"), &[Col::X, Col::Y]).unwrap();
+        assert_eq!(t.rows.iter().map(|r| (r.pos.y, r.line)).collect::<Vec<_>>(), vec![(0.0, 3), (2.0, 5)]);
+        let e = read(&input("x,y\r1,2\r1\r"), &[Col::X, Col::Y]).unwrap_err();
+        assert_eq!(e.to_string(), "in.csv:3: expected 2 fields like the header, found 1");
+        let t = read(&input("\u{feff}x,y\n1,2\n"), &[Col::X, Col::Y]).unwrap();
+        assert_eq!(t.rows[0].pos.y, 2.0);
     }
 
     #[test]
