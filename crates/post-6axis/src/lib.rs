@@ -7,6 +7,7 @@
 //! dialect ([`nc`]), and read back through the forward kinematics to measure what it really does
 //! ([`readback`]).
 
+pub mod branch;
 pub mod collision;
 pub mod link;
 pub mod nc;
@@ -174,6 +175,11 @@ pub const UNIT_EXACT: f64 = 1e-9;
 /// Fraction of `--spindle-tol` that planning works to.
 pub const SPINDLE_MARGIN: f64 = 0.8;
 
+/// Fraction of `--angle-tol` that planning works to: planning measures the axis against the arc
+/// between the rows' axes, the read-back check at the tip's nearest point of the CL, which may
+/// ask a little more.
+pub const ANGLE_MARGIN: f64 = 0.8;
+
 /// Samples per block in the read-back check.
 pub const CHECK_SAMPLES: usize = 8;
 
@@ -197,7 +203,7 @@ pub fn post(
     }
     let opts = plan::Options {
         tol: tol_used,
-        angle_tol: s.angle_tol.to_radians(),
+        angle_tol: s.angle_tol.to_radians() * ANGLE_MARGIN,
         // The check measures the spindle against the CL at the tip's nearest point, planning at the
         // block's own parameter: keep a margin between the two.
         spindle_tol: s.spindle_tol * SPINDLE_MARGIN,
@@ -215,17 +221,22 @@ pub fn post(
             .at(Location::file(file).line(rows[row].line).field("f"))
     })?;
     let check = check_text(&text, rows, machine, chain, s.tol)?;
-    let axis_bound = s.angle_tol + stats.pose_axis_error.to_degrees() * 2.0;
     if !camkit::tol::within(check.tip, s.tol) || !camkit::tol::within(check.coverage, s.tol) {
         return Err(Error::check(format!(
             "read back, the program deviates {:.6} mm from the CL (at NC line {}; rows {:.6} mm, at input line {}): more than --tol {} mm",
             check.tip, check.tip_line, check.coverage, rows[check.coverage_row].line, s.tol
         )));
     }
-    if check.axis_deg > axis_bound * (1.0 + 1e-6) + 1e-9 {
+    let over = |d: f64| d > s.angle_tol * (1.0 + 1e-6) + 1e-9;
+    if over(check.axis_deg) {
+        let beyond: Vec<usize> = (0..rows.len()).filter(|&i| over(check.row_axis_deg[i])).collect();
         return Err(Error::check(format!(
-            "read back, the tool axis deviates {:.5}° from the CL (NC line {}): more than --angle-tol {}°",
-            check.axis_deg, check.axis_line, s.angle_tol
+            "read back, the tool axis deviates {:.5}° from the CL (NC line {}, rows at input lines {}): more than \
+             --angle-tol {}°; the program is not written",
+            check.axis_deg,
+            check.axis_line,
+            lines_of(rows, &beyond),
+            s.angle_tol
         )));
     }
     if machine.spindle.is_some() && check.spindle_deg > s.spindle_tol * (1.0 + 1e-6) + 1e-9 {
@@ -235,6 +246,15 @@ pub fn post(
         )));
     }
     Ok(Posted { text, plan: stats, written, check, tol_used })
+}
+
+/// Input lines of rows (indices), as a short list: the first few and how many more.
+fn lines_of(rows: &[Cl], at: &[usize]) -> String {
+    let shown: Vec<String> = at.iter().take(8).map(|&i| rows[i].line.to_string()).collect();
+    match at.len() {
+        n if n > shown.len() => format!("{} and {} more", shown.join(", "), n - shown.len()),
+        _ => shown.join(", "),
+    }
 }
 
 /// Reads a program text back and compares it with the rows.
@@ -275,8 +295,9 @@ mod tests {
     proptest! {
         #![proptest_config(ProptestConfig { cases: 24, ..ProptestConfig::default() })]
 
-        /// Whatever the path, a program that is delivered reads back within the tolerances, by the
-        /// post's own check and by a four times denser one.
+        /// Whatever the path, a program that is delivered reads back within the tolerances (the
+        /// axis within --angle-tol, also near the singular cone), by the post's own check and by a
+        /// four times denser one.
         #[test]
         fn delivered_programs_read_back_within_tolerance(
             tilt in 0.0f64..60.0, turn in -200.0f64..200.0, wave in 0.0f64..6.0, which in 0usize..6,
@@ -292,8 +313,28 @@ mod tests {
             let reading = readback::Reading::new(&m, &chain);
             let dense = readback::verify(&rows, &readback::poses(&program, &reading), &reading, 4 * CHECK_SAMPLES, 0.002);
             prop_assert!(dense.tip <= 0.002 * (1.0 + 1e-9), "dense check {:?}", dense);
-            prop_assert!(dense.axis_deg <= 0.05 + 2.0 * posted.plan.pose_axis_error.to_degrees() + 1e-9, "{:?}", dense);
+            prop_assert!(dense.axis_deg <= 0.05 * (1.0 + 1e-6) + 1e-9, "{:?}", dense);
         }
+    }
+
+    /// A pass a random seed found on the head-bc machine: the program was delivered with the tool
+    /// axis 0.0539° off the CL by the four times denser read-back (tolerance 0.05°). Planned to a
+    /// margin of the tolerance, it reads back within it by both checks.
+    #[test]
+    fn head_bc_wavy_pass_holds_the_angle_tolerance() {
+        let (m, chain) = machine("head-bc.json");
+        let rows = pass(60, 54.5, 152.0, 5.73, false);
+        let s = Settings { tol: 0.002, ..Settings::default() };
+        let posted = post(&rows, "t", &m, &chain, &s, vec![]).expect("posts");
+        let program = read_axes("t", std::str::from_utf8(&posted.text).unwrap()).unwrap();
+        let reading = readback::Reading::new(&m, &chain);
+        let dense = readback::verify(&rows, &readback::poses(&program, &reading), &reading, 4 * CHECK_SAMPLES, 0.002);
+        assert!(
+            posted.check.axis_deg <= 0.05 && dense.axis_deg <= 0.05,
+            "{} {}",
+            posted.check.axis_deg,
+            dense.axis_deg
+        );
     }
 
     /// The read-back check runs chunks in parallel: the same figures on one thread as on four,
