@@ -337,6 +337,36 @@ mod tests {
         );
     }
 
+    /// Four passes on the six-axis machine, each turning the edge a further 350° with the feed: the
+    /// spindle orientation (B) stays continuous within a pass and is unwound where the next pass
+    /// starts (it once wound on to 1 400°, four turns).
+    #[test]
+    fn spindle_orientation_is_unwound_between_passes() {
+        let (m, chain) = machine("paper000-sixaxis-b.json");
+        let t = 10f64.to_radians();
+        let mut rows = Vec::new();
+        for pass in 0..4 {
+            for k in 0..=35 {
+                rows.push(Cl {
+                    tip: P3::new(-17.5 + k as f64, 5.0 * pass as f64, 10.0),
+                    axis: V3::new(0.0, t.sin(), t.cos()),
+                    s: Some(10.0 * k as f64),
+                    feed: Some(500.0),
+                    rapid: k == 0,
+                    reorient: k == 0,
+                    line: (pass * 36 + k) as u64 + 2,
+                    arc: None,
+                });
+            }
+        }
+        let posted = post(&rows, "t", &m, &chain, &Settings::default(), vec![]).expect("posts");
+        let program = read_axes("t", std::str::from_utf8(&posted.text).unwrap()).unwrap();
+        let b_max = program.moves.iter().map(|mv| mv.pos[4].abs()).fold(0.0, f64::max);
+        assert!(b_max > 350.0 && b_max < 720.0, "B continuous within a pass, unwound between: {b_max}");
+        assert_eq!(posted.plan.spindle_unwinds, 3, "{:?}", posted.plan);
+        assert!(posted.check.spindle_deg <= 0.5, "{:?}", posted.check);
+    }
+
     /// The read-back check runs chunks in parallel: the same figures on one thread as on four,
     /// over more blocks than one chunk holds.
     #[test]

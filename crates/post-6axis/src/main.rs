@@ -266,6 +266,7 @@ fn run(args: Args) -> Result<()> {
         .set("singular_rule", format!("{:?}", machine.singular).to_lowercase())
         .set("singular_axis_error_deg", posted.plan.pose_axis_error.to_degrees())
         .set("unwinds", posted.plan.unwinds)
+        .set("spindle_unwinds", posted.plan.spindle_unwinds)
         .set("tol_mm", settings.tol)
         .set("tol_used_mm", posted.tol_used)
         .set("angle_tol_deg", settings.angle_tol);

@@ -1,6 +1,7 @@
 //! From CL rows to machine blocks: a pose per row (inverse kinematics, the sequence of solutions
 //! [`crate::branch`] chooses, the primary axis held or interpolated near the singularity where that
-//! keeps the axis within tolerance, wrapping axes unwound between passes), then blocks inserted until the controller's linear interpolation of every axis keeps the
+//! keeps the axis within tolerance, wrapping axes and the spindle orientation unwound between
+//! passes), then blocks inserted until the controller's linear interpolation of every axis keeps the
 //! tool tip within `tol` of the straight CL segment and the tool axis within `angle_tol` of the CL's.
 
 use camkit::geom::dist::point_arc;
@@ -168,6 +169,8 @@ pub struct Stats {
     pub singular_rows: usize,
     /// Wrapping axes unwound at a pass start.
     pub unwinds: usize,
+    /// Spindle orientations unwound (past a full turn) at a pass start.
+    pub spindle_unwinds: usize,
     /// Largest tip deviation (mm) between blocks, as sampled while linearising.
     pub tip_deviation: f64,
     /// Largest axis deviation (radians) between blocks, as sampled while linearising.
@@ -300,7 +303,8 @@ fn lerp_joints(a: &Joints, b: &Joints, t: f64) -> Joints {
 }
 
 /// Poses for every row, before linearisation: the sequence [`crate::branch::choose`] finds, the
-/// primary angle interpolated through singular runs, the spindle orientation continuous.
+/// primary angle interpolated through singular runs, the spindle orientation continuous within a
+/// pass and unwound where the rotary axes may turn freely.
 fn poses(rows: &[Cl], m: &Machine, opts: &Options, stats: &mut Stats) -> Result<Vec<Step>, PlanError> {
     let chosen = crate::branch::choose(rows, m, opts)?;
     stats.unwinds += chosen.unwinds;
@@ -315,6 +319,12 @@ fn poses(rows: &[Cl], m: &Machine, opts: &Options, stats: &mut Stats) -> Result<
         m.check_travel(&xyz).map_err(|message| PlanError { row: i, message, unreachable: true })?;
         let joints = Joints { xyz, rot: c.rot };
         sigma = m.spindle_in(&frame, row.s, sigma).or(sigma);
+        if row.reorient
+            && let Some(sg) = sigma.filter(|sg| sg.abs() >= 360.0)
+        {
+            sigma = Some(principal_deg(sg));
+            stats.spindle_unwinds += 1;
+        }
         if c.singular {
             stats.singular_rows += 1;
             let axis = frame.column(2).into_owned();
