@@ -367,6 +367,22 @@ mod tests {
         assert!(posted.check.spindle_deg <= 0.5, "{:?}", posted.check);
     }
 
+    /// The read-back measures the program as written: with an angle tolerance below what the
+    /// rotary decimals (0.0001°, rounding by up to 0.00005° per axis) can hold, the rounded program misses it and is refused (a check
+    /// failure, exit 1), naming the NC line and the rows, not delivered.
+    #[test]
+    fn a_program_beyond_the_angle_tolerance_once_rounded_is_refused() {
+        let (m, chain) = machine("paper002-ac.json");
+        let rows = pass(40, 40.0, 120.0, 2.0, false);
+        let s = Settings { angle_tol: 0.00003, ..Settings::default() };
+        let e = match post(&rows, "t", &m, &chain, &s, vec![]) {
+            Ok(p) => panic!("delivered, the axis {}° off", p.check.axis_deg),
+            Err(e) => e,
+        };
+        assert_eq!(e.kind, camkit::error::ErrorKind::Check, "{e}");
+        assert!(e.to_string().contains("rows at input lines") && e.to_string().contains("--angle-tol 0.00003"), "{e}");
+    }
+
     /// The read-back check runs chunks in parallel: the same figures on one thread as on four,
     /// over more blocks than one chunk holds.
     #[test]
