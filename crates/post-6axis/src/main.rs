@@ -14,7 +14,7 @@ use camkit::kinematics::Chain;
 use camkit::report::Report;
 use camkit::table::{self, Col, WriteOptions};
 use clap::Parser;
-use post_6axis::{Settings, cl_rows, collision, link, post, readback};
+use post_6axis::{Settings, cl_rows, collision, judge, link, post, readback};
 use std::process::ExitCode;
 use std::time::Instant;
 
@@ -187,22 +187,8 @@ fn run(args: Args) -> Result<()> {
         deviation_keys(&mut report, &d);
         report.set("rows", rows.len()).set("tol_mm", settings.tol).set("angle_tol_deg", settings.angle_tol);
         out.buf = report.to_json().into_bytes();
-        let ok = camkit::tol::within(d.tip, settings.tol) && camkit::tol::within(d.coverage, settings.tol);
-        let axis_ok = camkit::tol::within(d.axis_deg, settings.angle_tol);
         finish(out, &args, report)?;
-        if !ok {
-            return Err(Error::check(format!(
-                "{nc}: the program deviates {:.6} mm from the CL (NC line {}), rows {:.6} mm from the program: more than --tol {}",
-                d.tip, d.tip_line, d.coverage, settings.tol
-            )));
-        }
-        if !axis_ok {
-            return Err(Error::check(format!(
-                "{nc}: the tool axis deviates {:.5}° from the CL (NC line {}): more than --angle-tol {}°",
-                d.axis_deg, d.axis_line, settings.angle_tol
-            )));
-        }
-        return Ok(());
+        return judge(&d, &rows, &machine, &settings).map_err(|e| Error::check(format!("{nc}: {}", e.message)));
     }
     let mut comments = vec![
         format!("post-6axis {}: {}", env!("CARGO_PKG_VERSION"), machine.name),
