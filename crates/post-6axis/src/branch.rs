@@ -122,12 +122,14 @@ fn beyond(m: &Machine, k: usize, angle: f64) -> String {
 /// inside their limits. Within a pass: the branch nearest `prev`, each axis turned the shorter way
 /// (wrapping axes by the policy), as the controller's interpolation continues it; the other branch
 /// would swing the axes in mid-cut. Wrapping axes are unwound where the row allows re-orientation.
+/// The reasons are written only if `explain` (they would cost a message per row).
 pub fn successors(
     m: &Machine,
     opts: &Options,
     row: &Cl,
     o: &Orientations,
     prev: &[f64; 2],
+    explain: bool,
 ) -> (Vec<Next>, Vec<String>) {
     let chain = m.solver.chain;
     let n = chain.rotaries().len();
@@ -149,7 +151,7 @@ pub fn successors(
             let mut combos: Vec<[f64; 2]> = vec![[0.0; 2]];
             for k in 0..n {
                 let eq = equivalents(m, k, rot[k], prev[k]);
-                if eq.is_empty() {
+                if eq.is_empty() && explain {
                     why.push(beyond(m, k, rot[k]));
                 }
                 combos = combos
@@ -184,10 +186,11 @@ pub fn successors(
         let best = (0..turned.len()).min_by(|&a, &b| cost(&turned[a]).total_cmp(&cost(&turned[b]))).unwrap_or(0);
         let v = turned[best];
         match (0..n).find(|&k| !chain.rotaries()[k].admits(v[k])) {
-            Some(k) => why.push(beyond(m, k, v[k])),
+            Some(k) if explain => why.push(beyond(m, k, v[k])),
+            Some(_) => {}
             None => values.push((best, v)),
         }
-        for w in turned.iter().enumerate().filter(|&(b, _)| b != best).map(|(_, w)| w) {
+        for w in turned.iter().enumerate().filter(|&(b, _)| explain && b != best).map(|(_, w)| w) {
             let names: Vec<String> =
                 chain.rotaries().iter().enumerate().map(|(k, r)| format!("{} {:.4}°", r.address, w[k])).collect();
             why.push(format!(
@@ -236,16 +239,13 @@ pub fn choose(rows: &[Cl], m: &Machine, opts: &Options) -> Result<Chosen, PlanEr
     for (i, row) in rows.iter().enumerate() {
         let o = orientations(m, row, i)?;
         let mut next: Vec<Node> = Vec::new();
-        let mut why = Vec::new();
         let prevs: Vec<(usize, Choice, f64)> = if i == 0 {
             vec![(usize::MAX, start, 0.0)]
         } else {
             layer.iter().map(|&p| (p, nodes[p].choice, nodes[p].cost)).collect()
         };
-        for (parent, pc, pcost) in prevs {
-            let (succ, reasons) = successors(m, opts, row, &o, &pc.rot);
-            why.extend(reasons);
-            for s in succ {
+        for &(parent, pc, pcost) in &prevs {
+            for s in successors(m, opts, row, &o, &pc.rot, false).0 {
                 let cost = pcost + s.cost;
                 let node = Node { choice: s.choice, cost, parent, unwinds: s.unwinds };
                 match next.iter_mut().find(|n| same_state(m, &n.choice.rot, &s.choice.rot)) {
@@ -256,6 +256,8 @@ pub fn choose(rows: &[Cl], m: &Machine, opts: &Options) -> Result<Chosen, PlanEr
             }
         }
         if next.is_empty() {
+            let mut why: Vec<String> =
+                prevs.iter().flat_map(|(_, pc, _)| successors(m, opts, row, &o, &pc.rot, true).1).collect();
             why.sort();
             why.dedup();
             return Err(PlanError {
@@ -305,7 +307,7 @@ mod tests {
             return Some(0.0);
         }
         let o = orientations(m, &rows[i], i).ok()?;
-        let (succ, _) = successors(m, opts, &rows[i], &o, prev);
+        let (succ, _) = successors(m, opts, &rows[i], &o, prev, false);
         succ.iter()
             .filter_map(|s| brute_force(rows, m, opts, i + 1, &s.choice.rot).map(|c| c + s.cost))
             .min_by(f64::total_cmp)
@@ -358,7 +360,7 @@ mod tests {
                     let mut total = 0.0;
                     for (i, (r, choice)) in rows.iter().zip(&c.choices).enumerate() {
                         let o = orientations(&m, r, i).unwrap();
-                        let (succ, _) = successors(&m, &opts, r, &o, &prev);
+                        let (succ, _) = successors(&m, &opts, r, &o, &prev, false);
                         let s = succ.iter().find(|s| same_state(&m, &s.choice.rot, &choice.rot));
                         prop_assert!(s.is_some(), "row {i}: {choice:?} is not a successor of {prev:?}");
                         total += s.unwrap().cost;
