@@ -66,7 +66,7 @@ fn axis_at(m: &Machine, rot: &[f64; 2]) -> V3 {
 }
 
 /// Angle (radians) between the tool axis at `c` and `axis`.
-pub fn pose_error(m: &Machine, c: &Choice, axis: &V3) -> f64 {
+fn pose_error(m: &Machine, c: &Choice, axis: &V3) -> f64 {
     angle_between(&axis_at(m, &c.rot), axis)
 }
 
