@@ -444,7 +444,8 @@ fn bad_input_is_refused_without_output() {
     run("").fails(2, "empty input");
     assert!(!w.exists("out.nc"));
     // Over the pole and down to latitude 59.6° beyond it, A would pass −30°: the machine must
-    // change branch (A and C by 180°) in the middle of the cut, which it is not allowed to do.
+    // change branch (A and C by 180°) in the middle of the cut, which it is not allowed to do. The
+    // row where A leaves its limits is named, with the limit and the swing the other branch needs.
     let mut over = String::from("path,x,y,z,i,j,k,f\n");
     for k in 0..=140 {
         let lat: f64 = 40.0 + k as f64 * 0.8;
@@ -453,7 +454,9 @@ fn bad_input_is_refused_without_output() {
         let n = V3::new(la.cos() * lo.cos(), la.cos() * lo.sin(), la.sin());
         over.push_str(&format!("0,{},{},{},{},{},{},300\n", 25.0 * n.x, 25.0 * n.y, 25.0 * n.z, n.x, n.y, n.z));
     }
-    run(&over).fails(2, "cannot follow the tool");
+    let out = run(&over);
+    out.fails(2, "in.csv:103 (i,j,k): no solution within the axis limits");
+    assert!(out.stderr.contains("A would be -30.8000°") && out.stderr.contains("in mid-pass"), "{}", out.stderr);
     assert!(!w.exists("out.nc"));
     // Travel limits are checked too.
     w.write("far.csv", "x,y,z,i,j,k,f\n0,0,0,0,0,1,100\n600,0,0,0,0,1,100\n");
@@ -465,6 +468,74 @@ fn bad_input_is_refused_without_output() {
     w.run(BIN, &["ok.csv", "--machine", &m, "--tol", "0"], b"").fails(2, "--tol must be a positive number");
     w.run(BIN, &["ok.csv", "--machine", &m, "--tol", "0.0000001"], b"")
         .fails(2, "too small for the program's decimals");
+}
+
+/// Issue 23 (P1): a pass in the XZ plane tilting the tool from −25° through the vertical to 110°.
+/// One branch (C 90°, A −25…110°) covers it, though the one nearer home (C −90°) runs A into its
+/// −30° limit at 30°: it was refused; now posted on the branch that covers it, both ways round.
+/// Past A's 120° limit on both branches it is refused, naming the row and the limit.
+#[test]
+fn a_sweep_through_the_vertical_is_posted_on_the_branch_that_covers_it() {
+    let w = Work::new();
+    let m = machine("paper002-ac.json");
+    let sweep = |to: usize| -> Vec<Row> {
+        (0..to)
+            .map(|k| {
+                let t = (-25.0 + 5.0 * k as f64).to_radians();
+                let tip = P3::new(-2.5 + 0.5 * k as f64, 0.0, 5.0);
+                Row { path: 0, rapid: k == 0, tip, axis: V3::new(t.sin(), 0.0, t.cos()), s: None }
+            })
+            .collect()
+    };
+    for reversed in [false, true] {
+        let mut rows = sweep(28);
+        if reversed {
+            rows.reverse();
+            rows[0].rapid = true;
+            rows[27].rapid = false;
+        }
+        let v = post(&w, &rows, &m, &[], "sweep.nc");
+        let b = blocks(&w.read("sweep.nc"));
+        assert!(b.iter().all(|q| q[4] == 90.0), "C stays at 90°: {b:?}");
+        let a = |f: fn(f64, f64) -> f64, init: f64| b.iter().map(|q| q[3]).fold(init, f);
+        assert_eq!((a(f64::min, f64::INFINITY), a(f64::max, f64::NEG_INFINITY)), (-25.0, 110.0));
+        assert!(figure(&v, "largest_axis_deviation_deg") <= 0.05, "{v}");
+        assert!(figure(&v, "largest_tip_deviation_mm") <= 0.005, "{v}");
+    }
+    w.write("far.csv", csv(&sweep(31), 800.0));
+    let out = w.run(BIN, &["far.csv", "--machine", &m, "-o", "far.nc"], b"");
+    out.fails(2, "far.csv:32 (i,j,k): no solution within the axis limits");
+    assert!(out.stderr.contains("A would be 125.0000°") && out.stderr.contains("-30..120"), "{}", out.stderr);
+    assert!(!w.exists("far.nc"));
+}
+
+/// Issue 23 (P2): a circle with the tool tilted 0.3° off the vertical, inside the machine's 0.5°
+/// singular cone, turning round with it. Holding C there left the axis 0.300° off on 71 of 73
+/// rows, delivered against the program's own 0.05° tolerance. C now follows the axis wherever
+/// holding it would leave more than half the tolerance: every block's axis, by the hand-written
+/// chain, is within 0.05° of the 0.3° cone.
+#[test]
+fn a_circle_just_off_the_vertical_holds_the_angle_tolerance() {
+    let w = Work::new();
+    let m = machine("paper002-ac.json");
+    let rows: Vec<Row> = (0..=72)
+        .map(|k| {
+            let (t, a) = (0.3f64.to_radians(), (5.0 * k as f64).to_radians());
+            let tip = P3::new(10.0 * a.cos(), 10.0 * a.sin(), 5.0);
+            let axis = V3::new(t.sin() * a.cos(), t.sin() * a.sin(), t.cos());
+            Row { path: 0, rapid: k == 0, tip, axis, s: None }
+        })
+        .collect();
+    let v = post(&w, &rows, &m, &[], "cone.nc");
+    assert!(figure(&v, "largest_axis_deviation_deg") <= 0.05, "{v}");
+    for q in blocks(&w.read("cone.nc")) {
+        let (_, axis) = paper_002_forward(q[0], q[1], q[2], q[3], q[4]);
+        let tilt = axis.z.min(1.0).acos().to_degrees();
+        assert!((tilt - 0.3).abs() <= 0.05, "block {q:?}: the axis is tilted {tilt}°");
+    }
+    let check = w.run(BIN, &["cl.csv", "--machine", &m, "--verify", "cone.nc"], b"");
+    let r: serde_json::Value = serde_json::from_str(&check.ok()).expect("JSON");
+    assert!(figure(&r, "largest_axis_deviation_deg") <= 0.05, "{r}");
 }
 
 /// LinuxCNC's own interpreter (Debian package linuxcnc-uspace, `rs274`) reads the LinuxCNC

@@ -7,6 +7,7 @@
 //! dialect ([`nc`]), and read back through the forward kinematics to measure what it really does
 //! ([`readback`]).
 
+pub mod branch;
 pub mod collision;
 pub mod link;
 pub mod nc;
@@ -174,6 +175,11 @@ pub const UNIT_EXACT: f64 = 1e-9;
 /// Fraction of `--spindle-tol` that planning works to.
 pub const SPINDLE_MARGIN: f64 = 0.8;
 
+/// Fraction of `--angle-tol` that planning works to: planning measures the axis against the arc
+/// between the rows' axes, the read-back check at the tip's nearest point of the CL, which may
+/// ask a little more.
+pub const ANGLE_MARGIN: f64 = 0.8;
+
 /// Samples per block in the read-back check.
 pub const CHECK_SAMPLES: usize = 8;
 
@@ -195,9 +201,20 @@ pub fn post(
             s.tol
         )));
     }
+    // Rounding a rotary value by δ turns the tool axis by at most δ.
+    let d = machine.program.decimals;
+    let angle_allowance = 0.5 * 10f64.powi(-(d.rotary as i32)) * chain.rotaries().len() as f64;
+    let angle_used = s.angle_tol * ANGLE_MARGIN - angle_allowance;
+    if angle_used < s.angle_tol / 4.0 {
+        return Err(Error::input(format!(
+            "--angle-tol {}° is too small for the program's rotary decimals (rounding alone may turn the tool axis \
+             {angle_allowance}°): raise --angle-tol or program.decimals",
+            s.angle_tol
+        )));
+    }
     let opts = plan::Options {
         tol: tol_used,
-        angle_tol: s.angle_tol.to_radians(),
+        angle_tol: angle_used.to_radians(),
         // The check measures the spindle against the CL at the tip's nearest point, planning at the
         // block's own parameter: keep a margin between the two.
         spindle_tol: s.spindle_tol * SPINDLE_MARGIN,
@@ -215,17 +232,30 @@ pub fn post(
             .at(Location::file(file).line(rows[row].line).field("f"))
     })?;
     let check = check_text(&text, rows, machine, chain, s.tol)?;
-    let axis_bound = s.angle_tol + stats.pose_axis_error.to_degrees() * 2.0;
+    judge(&check, rows, machine, s)?;
+    Ok(Posted { text, plan: stats, written, check, tol_used })
+}
+
+/// The verdict on a program read back: a check failure (exit 1) naming where it misses if the tip,
+/// the axis (anywhere, also in the singular cone) or the spindle orientation is beyond its
+/// tolerance.
+pub fn judge(check: &readback::Deviation, rows: &[Cl], machine: &Machine, s: &Settings) -> Result<()> {
     if !camkit::tol::within(check.tip, s.tol) || !camkit::tol::within(check.coverage, s.tol) {
         return Err(Error::check(format!(
             "read back, the program deviates {:.6} mm from the CL (at NC line {}; rows {:.6} mm, at input line {}): more than --tol {} mm",
             check.tip, check.tip_line, check.coverage, rows[check.coverage_row].line, s.tol
         )));
     }
-    if check.axis_deg > axis_bound * (1.0 + 1e-6) + 1e-9 {
+    let over = |d: f64| d > s.angle_tol * (1.0 + 1e-6) + 1e-9;
+    if over(check.axis_deg) {
+        let beyond: Vec<usize> = (0..rows.len()).filter(|&i| over(check.row_axis_deg[i])).collect();
         return Err(Error::check(format!(
-            "read back, the tool axis deviates {:.5}° from the CL (NC line {}): more than --angle-tol {}°",
-            check.axis_deg, check.axis_line, s.angle_tol
+            "read back, the tool axis deviates {:.5}° from the CL (NC line {}, rows at input lines {}): more than \
+             --angle-tol {}°",
+            check.axis_deg,
+            check.axis_line,
+            lines_of(rows, &beyond),
+            s.angle_tol
         )));
     }
     if machine.spindle.is_some() && check.spindle_deg > s.spindle_tol * (1.0 + 1e-6) + 1e-9 {
@@ -234,7 +264,16 @@ pub fn post(
             check.spindle_deg, s.spindle_tol
         )));
     }
-    Ok(Posted { text, plan: stats, written, check, tol_used })
+    Ok(())
+}
+
+/// Input lines of rows (indices), as a short list: the first few and how many more.
+fn lines_of(rows: &[Cl], at: &[usize]) -> String {
+    let shown: Vec<String> = at.iter().take(8).map(|&i| rows[i].line.to_string()).collect();
+    match at.len() {
+        n if n > shown.len() => format!("{} and {} more", shown.join(", "), n - shown.len()),
+        _ => shown.join(", "),
+    }
 }
 
 /// Reads a program text back and compares it with the rows.
@@ -275,8 +314,9 @@ mod tests {
     proptest! {
         #![proptest_config(ProptestConfig { cases: 24, ..ProptestConfig::default() })]
 
-        /// Whatever the path, a program that is delivered reads back within the tolerances, by the
-        /// post's own check and by a four times denser one.
+        /// Whatever the path, a program that is delivered reads back within the tolerances (the
+        /// axis within --angle-tol, also near the singular cone), by the post's own check and by a
+        /// four times denser one.
         #[test]
         fn delivered_programs_read_back_within_tolerance(
             tilt in 0.0f64..60.0, turn in -200.0f64..200.0, wave in 0.0f64..6.0, which in 0usize..6,
@@ -292,8 +332,84 @@ mod tests {
             let reading = readback::Reading::new(&m, &chain);
             let dense = readback::verify(&rows, &readback::poses(&program, &reading), &reading, 4 * CHECK_SAMPLES, 0.002);
             prop_assert!(dense.tip <= 0.002 * (1.0 + 1e-9), "dense check {:?}", dense);
-            prop_assert!(dense.axis_deg <= 0.05 + 2.0 * posted.plan.pose_axis_error.to_degrees() + 1e-9, "{:?}", dense);
+            prop_assert!(dense.axis_deg <= 0.05 * (1.0 + 1e-6) + 1e-9, "{:?}", dense);
         }
+    }
+
+    /// A pass a random seed found on the head-bc machine: the program was delivered with the tool
+    /// axis 0.0539° off the CL by the four times denser read-back (tolerance 0.05°). Planned to a
+    /// margin of the tolerance, it reads back within it by both checks.
+    #[test]
+    fn head_bc_wavy_pass_holds_the_angle_tolerance() {
+        let (m, chain) = machine("head-bc.json");
+        let rows = pass(60, 54.5, 152.0, 5.73, false);
+        let s = Settings { tol: 0.002, ..Settings::default() };
+        let posted = post(&rows, "t", &m, &chain, &s, vec![]).expect("posts");
+        let program = read_axes("t", std::str::from_utf8(&posted.text).unwrap()).unwrap();
+        let reading = readback::Reading::new(&m, &chain);
+        let dense = readback::verify(&rows, &readback::poses(&program, &reading), &reading, 4 * CHECK_SAMPLES, 0.002);
+        assert!(
+            posted.check.axis_deg <= 0.05 && dense.axis_deg <= 0.05,
+            "{} {}",
+            posted.check.axis_deg,
+            dense.axis_deg
+        );
+    }
+
+    /// Four passes on the six-axis machine, each turning the edge a further 350° with the feed: the
+    /// spindle orientation (B) stays continuous within a pass and is unwound where the next pass
+    /// starts (it once wound on to 1 400°, four turns).
+    #[test]
+    fn spindle_orientation_is_unwound_between_passes() {
+        let (m, chain) = machine("paper000-sixaxis-b.json");
+        let t = 10f64.to_radians();
+        let mut rows = Vec::new();
+        for pass in 0..4 {
+            for k in 0..=35 {
+                rows.push(Cl {
+                    tip: P3::new(-17.5 + k as f64, 5.0 * pass as f64, 10.0),
+                    axis: V3::new(0.0, t.sin(), t.cos()),
+                    s: Some(10.0 * k as f64),
+                    feed: Some(500.0),
+                    rapid: k == 0,
+                    reorient: k == 0,
+                    line: (pass * 36 + k) as u64 + 2,
+                    arc: None,
+                });
+            }
+        }
+        let posted = post(&rows, "t", &m, &chain, &Settings::default(), vec![]).expect("posts");
+        let program = read_axes("t", std::str::from_utf8(&posted.text).unwrap()).unwrap();
+        let b_max = program.moves.iter().map(|mv| mv.pos[4].abs()).fold(0.0, f64::max);
+        assert!(b_max > 350.0 && b_max < 720.0, "B continuous within a pass, unwound between: {b_max}");
+        assert_eq!(posted.plan.spindle_unwinds, 3, "{:?}", posted.plan);
+        assert!(posted.check.spindle_deg <= 0.5, "{:?}", posted.check);
+    }
+
+    /// Rounding the rotary values to 0.0001° may turn the tool axis by 0.0001° on a two-rotary
+    /// machine: planning keeps that share of --angle-tol free, and a tolerance it would leave
+    /// too little of is refused as bad input. A program read back beyond --angle-tol is refused as
+    /// a check failure naming the NC line and the rows it misses.
+    #[test]
+    fn the_angle_tolerance_allows_for_rounding_and_a_miss_names_the_rows() {
+        let (m, chain) = machine("paper002-ac.json");
+        let rows = pass(40, 40.0, 120.0, 2.0, false);
+        let s = Settings { angle_tol: 0.0001, ..Settings::default() };
+        let Err(e) = post(&rows, "t", &m, &chain, &s, vec![]) else { panic!("delivered") };
+        assert_eq!(e.kind, camkit::error::ErrorKind::Input, "{e}");
+        assert!(e.to_string().contains("too small for the program's rotary decimals"), "{e}");
+        let s = Settings { angle_tol: 0.0006, ..Settings::default() };
+        let posted = post(&rows, "t", &m, &chain, &s, vec![]).expect("posts");
+        assert!(posted.check.axis_deg <= 0.0006, "{:?}", posted.check);
+        let mut off = posted.check.clone();
+        off.axis_deg = 0.3;
+        off.axis_line = 42;
+        for i in [3, 4, 9] {
+            off.row_axis_deg[i] = 0.3;
+        }
+        let e = judge(&off, &rows, &m, &s).unwrap_err();
+        assert_eq!(e.kind, camkit::error::ErrorKind::Check, "{e}");
+        assert!(e.to_string().contains("NC line 42, rows at input lines 5, 6, 11"), "{e}");
     }
 
     /// The read-back check runs chunks in parallel: the same figures on one thread as on four,

@@ -1,8 +1,8 @@
-//! From CL rows to machine blocks: a pose per row (inverse kinematics, the solution inside the
-//! limits nearest the previous pose, the primary axis held or interpolated near the singularity,
-//! wrapping axes unwound between passes), then blocks inserted until the controller's linear
-//! interpolation of every axis keeps the tool tip within `tol` of the straight CL segment and the
-//! tool axis within `angle_tol` of the great-circle arc between the end axes.
+//! From CL rows to machine blocks: a pose per row (inverse kinematics, the sequence of solutions
+//! [`crate::branch`] chooses, the primary axis held or interpolated near the singularity where that
+//! keeps the axis within tolerance, wrapping axes and the spindle orientation unwound between
+//! passes), then blocks inserted until the controller's linear interpolation of every axis keeps the
+//! tool tip within `tol` of the straight CL segment and the tool axis within `angle_tol` of the CL's.
 
 use camkit::geom::dist::point_arc;
 use camkit::geom::{Arc2, P2, P3, Plane, V3};
@@ -169,6 +169,8 @@ pub struct Stats {
     pub singular_rows: usize,
     /// Wrapping axes unwound at a pass start.
     pub unwinds: usize,
+    /// Spindle orientations unwound (past a full turn) at a pass start.
+    pub spindle_unwinds: usize,
     /// Largest tip deviation (mm) between blocks, as sampled while linearising.
     pub tip_deviation: f64,
     /// Largest axis deviation (radians) between blocks, as sampled while linearising.
@@ -300,30 +302,14 @@ fn lerp_joints(a: &Joints, b: &Joints, t: f64) -> Joints {
     }
 }
 
-/// Poses for every row, before linearisation.
+/// Poses for every row, before linearisation: the sequence [`crate::branch::choose`] finds, the
+/// primary angle interpolated through singular runs, the spindle orientation continuous within a
+/// pass and unwound where the rotary axes may turn freely.
 fn poses(rows: &[Cl], m: &Machine, opts: &Options, stats: &mut Stats) -> Result<Vec<Step>, PlanError> {
-    let chain = m.chain();
-    let n_rot = chain.rotaries().len();
-    let mut prev = [0.0; 2];
-    for (k, r) in chain.rotaries().iter().enumerate() {
-        prev[k] = r.home;
-    }
-    let mut choices = Vec::with_capacity(rows.len());
-    for (i, row) in rows.iter().enumerate() {
-        let mut c =
-            m.solver.choose(&row.axis, &prev).map_err(|e| PlanError { row: i, message: e.0, unreachable: true })?;
-        if row.reorient {
-            for (k, r) in chain.rotaries().iter().enumerate() {
-                if r.wrap && c.rot[k].abs() >= 360.0 {
-                    c.rot[k] = principal_deg(c.rot[k]);
-                    stats.unwinds += 1;
-                }
-            }
-        }
-        prev = c.rot;
-        choices.push(c);
-    }
-    if n_rot == 2 {
+    let chosen = crate::branch::choose(rows, m, opts)?;
+    stats.unwinds += chosen.unwinds;
+    let mut choices = chosen.choices;
+    if m.chain().rotaries().len() == 2 {
         interpolate_singular_runs(rows, m, opts, &mut choices)?;
     }
     let mut steps = Vec::with_capacity(rows.len());
@@ -333,6 +319,12 @@ fn poses(rows: &[Cl], m: &Machine, opts: &Options, stats: &mut Stats) -> Result<
         m.check_travel(&xyz).map_err(|message| PlanError { row: i, message, unreachable: true })?;
         let joints = Joints { xyz, rot: c.rot };
         sigma = m.spindle_in(&frame, row.s, sigma).or(sigma);
+        if row.reorient
+            && let Some(sg) = sigma.filter(|sg| sg.abs() >= 360.0)
+        {
+            sigma = Some(principal_deg(sg));
+            stats.spindle_unwinds += 1;
+        }
         if c.singular {
             stats.singular_rows += 1;
             let axis = frame.column(2).into_owned();
@@ -388,17 +380,19 @@ fn interpolate_singular_runs(
         }
         let total = lengths.last().copied().unwrap_or(0.0);
         let mut prev = choices[first].rot;
+        let mut run = Vec::with_capacity(end - start);
         for k in start..end {
             let t = if total > 0.0 { lengths[k - first] / total } else { 0.5 };
             let primary = from + (to - from) * t;
-            let c = m.solver.hold(&rows[k].axis, primary, &prev).map_err(|e| PlanError {
-                row: k,
-                message: e.0,
-                unreachable: true,
-            })?;
-            choices[k] = c;
+            // A row the interpolated primary would leave beyond tolerance keeps the run held.
+            let Ok(c) = crate::branch::held(m, opts, &rows[k].axis, primary, &prev) else { break };
+            run.push(c);
             prev = c.rot;
         }
+        if run.len() < end - start {
+            continue;
+        }
+        choices[start..end].copy_from_slice(&run);
         // The row leaving the cone was chosen from the held value; keep it continuous with the
         // interpolated run.
         if after.is_some() {
@@ -419,17 +413,26 @@ fn interpolate_singular_runs(
 
 /// Deviations of the controller's path between two blocks: (tip mm, axis rad, spindle deg).
 fn segment_deviation(m: &Machine, opts: &Options, a: &Step, b: &Step, samples: &[f64]) -> (f64, f64, f64) {
-    let (axis_a, axis_b) = if a.singular || b.singular {
-        (m.at(&a.joints, opts.tcp).1, m.at(&b.joints, opts.tcp).1)
-    } else {
-        (a.cl.axis, b.cl.axis)
-    };
+    // Against the CL's axes, also where a pose holds the primary angle: its own axis error counts.
+    let (axis_a, axis_b) = (a.cl.axis, b.cl.axis);
+    let chord = b.cl.tip - a.cl.tip;
+    let len = chord.norm();
     let (mut dt, mut da, mut ds) = (0.0f64, 0.0f64, 0.0f64);
     for &t in samples {
         let q = lerp_joints(&a.joints, &b.joints, t);
         let (tip, axis, frame) = m.at(&q, opts.tcp);
-        dt = dt.max(point_segment(&tip, &a.cl.tip, &b.cl.tip));
-        da = da.max(vector_arc(&axis, &axis_a, &axis_b));
+        let d = point_segment(&tip, &a.cl.tip, &b.cl.tip);
+        dt = dt.max(d);
+        // As the read-back measures it: against the CL axes where the tip is (the part of the
+        // segment within `tol` of it); a segment shorter than that turns the axis on the spot.
+        da = da.max(if len > opts.tol {
+            let u = ((tip - a.cl.tip).dot(&chord) / (len * len)).clamp(0.0, 1.0);
+            let half = (opts.tol * opts.tol - d * d).max(0.0).sqrt() / len;
+            let (lo, hi) = ((u - half).max(0.0), (u + half).min(1.0));
+            vector_arc(&axis, &slerp(&axis_a, &axis_b, lo), &slerp(&axis_a, &axis_b, hi))
+        } else {
+            vector_arc(&axis, &axis_a, &axis_b)
+        });
         if let (Some(sa), Some(sb), Some(ca), Some(cb)) = (a.spindle, b.spindle, a.cl.s, b.cl.s) {
             let sp = m.spindle.expect("spindle angles need a spindle");
             let want_s = ca + principal_deg(cb - ca) * t;
@@ -481,19 +484,60 @@ fn pose_at(m: &Machine, opts: &Options, a: &Step, b: &Step, tip: P3, t: f64) -> 
         _ => b.cl.s,
     };
     let cl = Cl { tip, axis, s, feed: b.cl.feed, rapid: false, reorient: false, line: b.cl.line, arc: None };
-    let chain = m.chain();
-    let singular = a.singular || b.singular;
-    let c = if singular && chain.rotaries().len() == 2 {
-        let primary = a.joints.rot[0] + (b.joints.rot[0] - a.joints.rot[0]) * t;
-        m.solver.hold(&axis, primary, &a.joints.rot)
-    } else {
-        m.solver.choose(&axis, &a.joints.rot)
-    }
-    .map_err(|e| PlanError { row: b.row, message: e.0, unreachable: true })?;
+    let target = lerp_joints(&a.joints, &b.joints, t).rot;
+    let c = pose_between(m, opts, &axis, &a.joints.rot, &target, a.singular || b.singular)
+        .map_err(|message| PlanError { row: b.row, message, unreachable: true })?;
+    let singular = c.singular;
     let (xyz, frame) = m.linear(&tip, &c.rot, opts.tcp);
     m.check_travel(&xyz).map_err(|message| PlanError { row: b.row, message, unreachable: true })?;
     let spindle = m.spindle_in(&frame, s, a.spindle).filter(|_| s.is_some());
     Ok(Step { joints: Joints { xyz, rot: c.rot }, spindle, cl, row: b.row, inserted: true, singular, arc: None })
+}
+
+/// The pose for tool axis `axis` on the joint move from `prev` towards `target`: the primary
+/// angle held at the target's where the move is singular or the axis lies in the singular cone
+/// and the hold keeps the axis within tolerance ([`crate::branch::held`]); otherwise the exact
+/// solution (unwound from `prev`) nearest the target, so that a block inserted between two poses
+/// stays on their branch.
+fn pose_between(
+    m: &Machine,
+    opts: &Options,
+    axis: &V3,
+    prev: &[f64; 2],
+    target: &[f64; 2],
+    singular: bool,
+) -> Result<camkit::kinematics::Choice, String> {
+    let chain = m.chain();
+    let n = chain.rotaries().len();
+    let o = chain.orientations(axis);
+    let in_cone = o.is_some_and(|o| o.count == 2 && o.off_primary < m.solver.cone);
+    if n == 2 && (singular || in_cone) {
+        match crate::branch::held(m, opts, axis, target[0], prev) {
+            Ok(c) => return Ok(c),
+            Err(e) if o.is_none() => return Err(e),
+            Err(_) => {}
+        }
+    }
+    let Some(o) = o else { return m.solver.choose(axis, prev).map_err(|e| e.0) };
+    let mut best: Option<(f64, camkit::kinematics::Choice)> = None;
+    for (b, rot) in o.branch[..o.count].iter().enumerate() {
+        let mut out = [0.0; 2];
+        let mut ok = true;
+        for k in 0..n {
+            match m.solver.unwind(k, rot[k], prev[k]) {
+                Some(v) => out[k] = v,
+                None => ok = false,
+            }
+        }
+        let d: f64 = (0..n).map(|k| (out[k] - target[k]).abs()).sum();
+        if ok && best.is_none_or(|(c, _)| d < c) {
+            best = Some((d, camkit::kinematics::Choice { rot: out, branch: b, singular: false }));
+        }
+    }
+    match best {
+        Some((_, c)) => Ok(c),
+        None => m.solver.choose(axis, prev).map_err(|e| e.0),
+    }
 }
 
 /// The controller's arc for the CL arc from `a` to `b`, when the controller can run it as G2/G3:

@@ -184,7 +184,7 @@ impl Reading<'_> {
 }
 
 /// Largest deviations of a program from its CL rows.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct Deviation {
     /// Largest distance (mm) of the interpolated tool tip from the CL polyline.
     pub tip: f64,
@@ -198,6 +198,9 @@ pub struct Deviation {
     pub axis_deg: f64,
     /// NC line where it occurs.
     pub axis_line: u32,
+    /// Largest axis deviation (degrees) of the samples nearest each CL segment, by the index of
+    /// the row it ends at (0 for rows that start a pass): which rows a program misses.
+    pub row_axis_deg: Vec<f64>,
     /// Largest error (degrees) of the spindle orientation.
     pub spindle_deg: f64,
     /// Feed blocks compared.
@@ -277,12 +280,12 @@ pub fn verify(cl: &[Cl], poses: &[Option<NcPose>], r: &Reading, samples_per_bloc
     let mut dev = Deviation::default();
     if !segs.is_empty() {
         // The first chunk starts its search at the first segment, as a sequential check would.
-        let parts: Vec<Deviation> = blocks
+        let parts: Vec<(Deviation, Vec<(usize, f64)>)> = blocks
             .par_chunks(CHUNK)
             .enumerate()
             .map(|(c, chunk)| check_blocks(cl, &segs, &paths, chunk, (c == 0).then_some(0), r, samples_per_block, far))
             .collect();
-        for p in parts {
+        for (p, _) in &parts {
             if p.tip > dev.tip {
                 (dev.tip, dev.tip_line) = (p.tip, p.tip_line);
             }
@@ -292,6 +295,10 @@ pub fn verify(cl: &[Cl], poses: &[Option<NcPose>], r: &Reading, samples_per_bloc
             dev.spindle_deg = dev.spindle_deg.max(p.spindle_deg);
             dev.blocks += p.blocks;
             dev.samples += p.samples;
+        }
+        dev.row_axis_deg = vec![0.0; cl.len()];
+        for &(i, d) in parts.iter().flat_map(|(_, rows)| rows) {
+            dev.row_axis_deg[i] = dev.row_axis_deg[i].max(d);
         }
     }
     // Coverage: every CL row lies on the program's path.
@@ -410,7 +417,8 @@ fn axis_deviation(
 }
 
 /// The block part of [`verify`] for one chunk of consecutive feed blocks, the nearest-segment
-/// search starting at `hint` (none: a full search).
+/// search starting at `hint` (none: a full search); with the largest axis deviation near each row
+/// sampled, as (row, degrees).
 #[allow(clippy::too_many_arguments)]
 fn check_blocks(
     cl: &[Cl],
@@ -421,8 +429,9 @@ fn check_blocks(
     r: &Reading,
     samples_per_block: usize,
     far: f64,
-) -> Deviation {
+) -> (Deviation, Vec<(usize, f64)>) {
     let mut dev = Deviation::default();
+    let mut by_row: Vec<(usize, f64)> = Vec::new();
     for &(a, b) in blocks {
         dev.blocks += 1;
         let samples = samples_of(a, b, samples_per_block);
@@ -448,6 +457,11 @@ fn check_blocks(
                 dev.axis_deg = da;
                 dev.axis_line = b.line;
             }
+            // Consecutive samples near one row merged.
+            match by_row.last_mut() {
+                Some((row, d)) if *row == i1 => *d = d.max(da),
+                _ => by_row.push((i1, da)),
+            }
             let sigma = match (r.spindle, a.sigma, b.sigma) {
                 (Some((SpindleMode::Axis, ..)), Some(x), Some(y)) => Some(x + (y - x) * t),
                 (Some((SpindleMode::M19, ..)), _, y) => y,
@@ -461,7 +475,7 @@ fn check_blocks(
             }
         }
     }
-    dev
+    (dev, by_row)
 }
 
 /// The program as a toolpath table: tool tip, axis, spindle orientation and feed (mm/min) per
