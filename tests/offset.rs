@@ -684,3 +684,29 @@ fn a_kernel_debug_assertion_never_reaches_the_user() {
         }
     }
 }
+
+/// A square 20 km from the origin (once a panic in the epsilon ladder: round-off there is above
+/// the ladder's cap) is offset like the same square at the origin, moved; so are its pocket and
+/// medial-trochoid's plan of it.
+#[test]
+fn far_from_the_origin_the_offset_is_the_same_moved() {
+    let w = Work::new();
+    let square = |x0: f64| {
+        let mut s = String::from("path,move,x,y\n");
+        for (x, y) in [(0.0, 0.0), (60.0, 0.0), (60.0, 40.0), (0.0, 40.0), (0.0, 0.0)] {
+            s.push_str(&format!("1,line,{},{y}\n", x0 + x));
+        }
+        s
+    };
+    w.write("near.csv", square(0.0));
+    w.write("far.csv", square(2e7));
+    for args in [&["--radius", "1", "--side", "left"][..], &["--radius", "3", "--until-empty"][..]] {
+        let near = table(&w.run(BIN, &[&["near.csv"], args].concat(), b"").ok());
+        let far = table(&w.run(BIN, &[&["far.csv"], args].concat(), b"").ok());
+        assert_eq!(near.len(), far.len(), "{args:?}");
+        for (a, b) in near.iter().zip(&far) {
+            assert!((num(b, "x") - 2e7 - num(a, "x")).abs() < 1e-6 && (num(b, "y") - num(a, "y")).abs() < 1e-6);
+        }
+    }
+    w.run("medial-trochoid", &["far.csv", "--radius", "5"], b"").ok();
+}

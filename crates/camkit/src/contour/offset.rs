@@ -127,7 +127,8 @@ fn box_size((lo, hi): (crate::geom::P2, crate::geom::P2)) -> f64 {
 /// The epsilon ladder for pieces within a box of `size` (mm, at least 1) whose shortest is
 /// `shortest` long.
 fn ladder_for(size: f64, shortest: f64) -> Vec<Eps> {
-    let pos = (shortest * 1e-4).clamp(size * 1e-12, 1e-5);
+    // Far from the origin round-off sets the floor, whatever the pieces' lengths.
+    let pos = (shortest * 1e-4).min(1e-5).max(size * 1e-12);
     let scaled = (pos, (pos * 10.0).min(1e-6).max(pos));
     let mut out = vec![scaled];
     for e in [(1e-5, 1e-4), (1e-8, 1e-6), (1e-6, 1e-5), (1e-9, 1e-8), (1e-7, 1e-7)] {
