@@ -35,11 +35,13 @@ pub struct Line {
 }
 
 impl Line {
-    fn at(&self, s: f64, z: f64) -> P3 {
+    /// The point at parameter `s`, height `z`.
+    pub fn at(&self, s: f64, z: f64) -> P3 {
         P3::new(self.origin.x + self.dir.x * s, self.origin.y + self.dir.y * s, z)
     }
 
-    fn s_of(&self, p: &P3) -> f64 {
+    /// The parameter of `p`'s foot on the line.
+    pub fn s_of(&self, p: &P3) -> f64 {
         (p - self.origin).dot(&self.dir)
     }
 }
@@ -81,9 +83,15 @@ pub fn lines(scan: &Scan) -> Vec<Line> {
     out
 }
 
-/// Traces one scan line; the passes it yields, in order. A pass ends at the region's end, where
+/// Traces scan line number `unit`; the passes it yields, in order. A pass ends at the region's end, where
 /// the model falls away (an overhang), or where the stylus cannot follow it (`interrupted`).
-pub fn trace_line(model: &Model, stylus: Stylus, steps: &Steps, line: &Line) -> Result<Vec<TracedPath>, Failure> {
+pub fn trace_line(
+    model: &Model,
+    stylus: Stylus,
+    steps: &Steps,
+    line: &Line,
+    unit: usize,
+) -> Result<Vec<TracedPath>, Failure> {
     let curve = PlaneCurve { model, stylus, plane_normal: V3::z().cross(&line.dir), flat_moves: None };
     let bounds = model.bounds();
     let (z_top, z_bottom) = if bounds.is_bounded() {
@@ -139,7 +147,7 @@ pub fn trace_line(model: &Model, stylus: Stylus, steps: &Steps, line: &Line) -> 
             h = st.next;
             pts.push(next);
         }
-        paths.push(TracedPath { points: pts.into_iter().map(|p| p.cl).collect(), deviation, interrupted });
+        paths.push(TracedPath { points: pts.into_iter().map(|p| p.cl).collect(), deviation, interrupted, unit });
         // Always onwards: a drop's correction may have landed behind where it was dropped.
         s = if ended_at >= line.s1 { f64::INFINITY } else { ended_at.max(s) + steps.min_step.max(1e-3) };
     }

@@ -1,0 +1,210 @@
+//! The coverage check of scan mode: every scan line's written CL points against an independent
+//! drop of the stylus ([`crate::envelope`]) at the line's sample positions. A line is covered when
+//! no stretch longer than the gap tolerance, with the model under it, lies outside every pass,
+//! and no CL point lies below the upper envelope by more than the envelope tolerance (the
+//! envelope taken as its lowest over ±that tolerance along the line, so a pass climbing a vertical
+//! wall at a step of the envelope is not counted).
+
+use crate::TracedPath;
+use crate::envelope::Dropper;
+use crate::scan::{self, Line, Scan};
+use camkit::geom::P3;
+use camkit::model::Model;
+use rayon::prelude::*;
+
+/// What the check asks.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Tolerances {
+    /// Longest stretch of a line, with the model under it, that no pass may cover (mm).
+    pub gap: f64,
+    /// Deepest a written point may lie below the envelope (mm).
+    pub below: f64,
+    /// Spacing of the sample positions along a line (mm).
+    pub spacing: f64,
+}
+
+/// A line that fails the check: where, and how.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Defect {
+    /// Line number (0-based, in output order).
+    pub line: usize,
+    /// Start of the stretch (stylus centre XY, z 0).
+    pub from: P3,
+    /// End of the stretch.
+    pub to: P3,
+    /// What is wrong.
+    pub what: String,
+}
+
+/// Figures of the check over all lines.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Coverage {
+    /// Scan lines checked.
+    pub lines: usize,
+    /// Drops made.
+    pub drops: usize,
+    /// Longest stretch with the model under it that no pass covers (mm).
+    pub largest_gap: f64,
+    /// Written points below the envelope by more than the tolerance.
+    pub points_below: usize,
+    /// Largest depth of a written point below the envelope (mm; 0 when none is below).
+    pub largest_below: f64,
+    /// The failing stretches, in line order.
+    pub defects: Vec<Defect>,
+}
+
+/// Checks the written scan: `paths` carry their line number in `unit`, `round` maps a
+/// coordinate to what is written.
+pub fn check(
+    model: &Model,
+    radius: f64,
+    scan: &Scan,
+    paths: &[TracedPath],
+    tol: &Tolerances,
+    round: &(dyn Fn(f64) -> f64 + Sync),
+) -> Coverage {
+    let dropper = Dropper::new(model, radius, (tol.below * 0.1).max(1e-9));
+    let lines = scan::lines(scan);
+    let per_line: Vec<LineFigures> = lines
+        .par_iter()
+        .enumerate()
+        .map(|(k, line)| {
+            let written: Vec<Vec<P3>> = paths
+                .iter()
+                .filter(|p| p.unit == k)
+                .map(|p| p.points.iter().map(|q| q.centre.map(round)).collect())
+                .collect();
+            check_line(&dropper, k, line, &written, tol)
+        })
+        .collect();
+    let mut out = Coverage { lines: lines.len(), ..Coverage::default() };
+    for f in per_line {
+        out.drops += f.drops;
+        out.largest_gap = out.largest_gap.max(f.largest_gap);
+        out.points_below += f.below;
+        out.largest_below = out.largest_below.max(f.largest_below);
+        out.defects.extend(f.defects);
+    }
+    out
+}
+
+#[derive(Default)]
+struct LineFigures {
+    drops: usize,
+    largest_gap: f64,
+    below: usize,
+    largest_below: f64,
+    defects: Vec<Defect>,
+}
+
+fn check_line(d: &Dropper, k: usize, line: &Line, passes: &[Vec<P3>], tol: &Tolerances) -> LineFigures {
+    let mut f = LineFigures::default();
+    let at = |s: f64| line.at(s, 0.0);
+    let drop = |s: f64, f: &mut LineFigures| {
+        f.drops += 1;
+        let p = at(s);
+        d.drop(p.x, p.y)
+    };
+    // Covered stretches of the line parameter, merged.
+    let mut covered: Vec<(f64, f64)> = passes
+        .iter()
+        .filter(|p| !p.is_empty())
+        .map(|p| p.iter().map(|q| line.s_of(q)).fold((f64::INFINITY, -f64::INFINITY), |(a, b), s| (a.min(s), b.max(s))))
+        .collect();
+    covered.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let mut holes = Vec::new();
+    let mut reach = line.s0;
+    for (a, b) in covered {
+        if a > reach {
+            holes.push((reach, a.min(line.s1)));
+        }
+        reach = reach.max(b);
+    }
+    if reach < line.s1 {
+        holes.push((reach, line.s1));
+    }
+    let delta = tol.gap * 0.25;
+    for (a, b) in holes.into_iter().filter(|(a, b)| b > a) {
+        let mut samples = if b - a <= 2.0 * delta {
+            vec![0.5 * (a + b)]
+        } else {
+            let mut v = vec![a + delta];
+            let first = ((a - line.s0) / tol.spacing).floor() as i64 + 1;
+            let mut j = first;
+            while line.s0 + j as f64 * tol.spacing < b - delta {
+                let s = line.s0 + j as f64 * tol.spacing;
+                if s > a + delta {
+                    v.push(s);
+                }
+                j += 1;
+            }
+            v.push(b - delta);
+            v
+        };
+        samples.dedup();
+        let hits: Vec<bool> = samples.iter().map(|&s| drop(s, &mut f).is_some()).collect();
+        let (Some(i0), Some(i1)) = (hits.iter().position(|&h| h), hits.iter().rposition(|&h| h)) else {
+            continue;
+        };
+        // The model's stretch within the hole: to the hole's end where the end sample hits, else
+        // bisected against the neighbouring miss.
+        let edge = |hit: f64, miss: f64, f: &mut LineFigures| {
+            let (mut h, mut m) = (hit, miss);
+            while (h - m).abs() > delta {
+                let mid = 0.5 * (h + m);
+                if drop(mid, f).is_some() {
+                    h = mid;
+                } else {
+                    m = mid;
+                }
+            }
+            h
+        };
+        let lo = if i0 == 0 { a } else { edge(samples[i0], samples[i0 - 1], &mut f) };
+        let hi = if i1 == samples.len() - 1 { b } else { edge(samples[i1], samples[i1 + 1], &mut f) };
+        let gap = (hi - lo).max(0.0);
+        f.largest_gap = f.largest_gap.max(gap);
+        if gap > tol.gap {
+            f.defects.push(Defect {
+                line: k,
+                from: at(lo),
+                to: at(hi),
+                what: format!("the model is under it but no pass covers {gap:.3} mm"),
+            });
+        }
+    }
+    // Written points against the envelope, lowest over ±the tolerance along the line.
+    let mut below: Option<(P3, P3, f64, usize)> = None;
+    for p in passes.iter().flatten() {
+        let s = line.s_of(p);
+        let mut env = f64::INFINITY;
+        // The neighbours only matter when the point is below the envelope right over it.
+        for ds in [0.0, -tol.below, tol.below] {
+            if env - p.z <= tol.below {
+                break;
+            }
+            let q = P3::new(p.x, p.y, 0.0) + line.dir * ds;
+            f.drops += 1;
+            env = env.min(d.drop(q.x, q.y).unwrap_or(-f64::INFINITY));
+        }
+        let depth = env - p.z;
+        if depth > tol.below {
+            f.below += 1;
+            f.largest_below = f.largest_below.max(depth);
+            let here = at(s);
+            below = Some(match below {
+                None => (here, here, depth, 1),
+                Some((a, _, m, n)) => (a, here, m.max(depth), n + 1),
+            });
+        }
+    }
+    if let Some((from, to, depth, n)) = below {
+        f.defects.push(Defect {
+            line: k,
+            from,
+            to,
+            what: format!("{n} CL points lie below the stylus's upper envelope, by up to {depth:.3} mm"),
+        });
+    }
+    f
+}
