@@ -90,7 +90,7 @@ pub struct Stylus {
 
 impl Stylus {
     /// |ΔR| the corrections aim for: well inside the tolerance, since Newton converges fast.
-    fn target(&self) -> f64 {
+    pub fn target(&self) -> f64 {
         (self.contact_tol * 1e-3).max(1e-12 * self.radius)
     }
 }
@@ -113,11 +113,17 @@ pub struct PlaneCurve<'a> {
 }
 
 impl PlaneCurve<'_> {
-    /// The curve point at a converged centre.
-    fn finish(&self, c: P3, n: &Nearest, iterations: u32) -> Option<CurvePoint> {
+    /// The curve point at a converged centre. Where L stands square to the motion plane (a
+    /// scan line right over a contact on a wall parallel to it) the curve runs level: the tangent
+    /// is the plane's horizontal direction then.
+    pub fn finish(&self, c: P3, n: &Nearest, iterations: u32) -> Option<CurvePoint> {
         let u = n.direction(&c);
         let g = u - self.plane_normal * u.dot(&self.plane_normal);
-        let tangent = self.plane_normal.cross(&g).try_normalize(1e-9)?;
+        let tangent = self
+            .plane_normal
+            .cross(&g)
+            .try_normalize(1e-9)
+            .or_else(|| self.plane_normal.cross(&V3::z()).try_normalize(1e-9))?;
         let cl = ClPoint {
             centre: c,
             contact: n.point,
@@ -283,7 +289,7 @@ pub struct Steps {
 
 /// Fraction of the chord tolerance a step aims for (the estimate below can miss a corner's
 /// deviation by up to a quarter).
-const AIM: f64 = 0.7;
+pub const AIM: f64 = 0.7;
 
 /// An accepted step.
 #[derive(Clone, Copy, Debug)]

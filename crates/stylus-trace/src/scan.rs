@@ -1,9 +1,13 @@
 //! Scanning-line mode: motion planes stand vertical along the scan direction, one per pick feed;
 //! on each the stylus is dropped from above onto the model and then copies it to the end of the
-//! region. Where the model falls away under the stylus (an overhang, the edge of a sheet) the pass
-//! ends and the stylus is dropped again beyond it.
+//! region. The CL of a line is the stylus's upper envelope over the model: a pass goes on only
+//! while its points are on it (touching from above, moving on, nothing of the model over them),
+//! so it ends at a silhouette (the model falls away: an overhang, the edge of a sheet) or under
+//! something higher, at the point found by bisection, and the stylus is dropped again just beyond.
+//! Where copying cannot go on (the motion plane nearly tangent to the offset surface) the pass
+//! goes on by drops while their chords stay within the chord tolerance.
 
-use crate::curve::{Curve, CurvePoint, PlaneCurve, Steps, Stylus, step};
+use crate::curve::{AIM, Curve, CurvePoint, PlaneCurve, Steps, Stylus, step};
 use crate::{Failure, Region, TracedPath};
 use camkit::geom::{P3, V3};
 use camkit::model::Model;
@@ -83,8 +87,22 @@ pub fn lines(scan: &Scan) -> Vec<Line> {
     out
 }
 
-/// Traces scan line number `unit`; the passes it yields, in order. A pass ends at the region's end, where
-/// the model falls away (an overhang), or where the stylus cannot follow it (`interrupted`).
+/// What a line's tracer needs besides the line: the curve, the column heights and the steps.
+struct Tracer<'a> {
+    curve: PlaneCurve<'a>,
+    line: &'a Line,
+    steps: &'a Steps,
+    /// Where drops start.
+    z_top: f64,
+    /// Where a drop gives up.
+    z_bottom: f64,
+    /// How far past a pass's end the stylus is dropped again (below the coverage check's gap
+    /// tolerance, the chord tolerance).
+    hop: f64,
+}
+
+/// Traces line number `unit`; the passes it yields, in order. A pass ends at the region's end,
+/// at a silhouette, under a higher part of the model, or where the envelope jumps.
 pub fn trace_line(
     model: &Model,
     stylus: Stylus,
@@ -99,15 +117,145 @@ pub fn trace_line(
     } else {
         (1e4, -1e4)
     };
+    let hop = (steps.chord_tol * 0.5).max(steps.min_step);
+    let t = Tracer { curve, line, steps, z_top, z_bottom, hop };
     // Where nothing is under the stylus, look again this far on.
     let probe = steps.max_step.min(stylus.radius * 0.5);
     let mut paths = Vec::new();
     let mut s = line.s0;
+    let mut missed: Option<f64> = None;
     while s <= line.s1 {
-        let Some(start) = drop(&curve, line, s, z_top, z_bottom) else {
+        let Some(mut start) = t.land(s) else {
+            missed = Some(s);
             s = if s < line.s1 { (s + probe).min(line.s1) } else { f64::INFINITY };
             continue;
         };
+        // After a miss, the model's shadow begins somewhere before s: find it.
+        if let Some(mut m) = missed.take() {
+            let mut hit = s;
+            while hit - m > 0.5 * t.hop {
+                let mid = 0.5 * (m + hit);
+                match t.land(mid) {
+                    Some(p) => {
+                        hit = mid;
+                        start = p;
+                    }
+                    None => m = mid,
+                }
+            }
+        }
+        let (pass, ended_at) = t.follow(start);
+        paths.push(TracedPath { unit, ..pass });
+        // Always onwards: a drop's correction may have landed behind where it was dropped.
+        s = if ended_at >= line.s1 { f64::INFINITY } else { ended_at.max(s) + t.hop };
+    }
+    Ok(paths)
+}
+
+impl Tracer<'_> {
+    fn s_of(&self, p: &CurvePoint) -> f64 {
+        self.line.s_of(&p.cl.centre)
+    }
+
+    /// True when `b`, reached from `a`, is on the upper envelope: it touches from above or from
+    /// the side (the tangent does not turn back), it does not go back along the line, and no
+    /// part of the model lies over it (checked where the contact faces up; a pass climbing a
+    /// vertical wall is left to the coverage check).
+    fn on_envelope(&self, a: &CurvePoint, b: &CurvePoint) -> bool {
+        let back = 1e-9;
+        if b.tangent.dot(&self.line.dir) < -back || self.s_of(b) < self.s_of(a) - back {
+            return false;
+        }
+        let up = b.cl.normal.z;
+        if up < 0.05 {
+            return true;
+        }
+        let margin = 10.0 * self.curve.stylus.contact_tol / up;
+        let c = b.cl.centre;
+        !matches!(self.descend(c.x, c.y, c.z + margin), Descent::Contact { .. })
+    }
+
+    /// The stylus dropped at `s` onto its highest contact, or `None` if nothing is under it.
+    fn land(&self, s: f64) -> Option<CurvePoint> {
+        let p = self.line.at(s, 0.0);
+        match self.descend(p.x, p.y, self.z_bottom) {
+            Descent::Contact { below, above } => self.settle(s, below, above),
+            Descent::Clear => None,
+        }
+    }
+
+    /// Sphere tracing down the vertical through (x, y) from the top to `z_stop`: steps of
+    /// |L| − r never pass a contact, |L| being 1-Lipschitz; near a face that faces up the step
+    /// is the vertical Newton step (|L| − r)/L̂_z, and it is never shorter than a length that can
+    /// pass a contact only by a depth of step²/8r, the contact tolerance (beside a vertical wall
+    /// |L| − r stays small without a contact below).
+    fn descend(&self, x: f64, y: f64, z_stop: f64) -> Descent {
+        let (r, tol) = (self.curve.stylus.radius, self.curve.stylus.contact_tol);
+        let least = (8.0 * r * tol).sqrt();
+        let mut z = self.z_top;
+        let mut above = None;
+        for _ in 0..100_000 {
+            if z < z_stop {
+                return Descent::Clear;
+            }
+            let c = P3::new(x, y, z);
+            let n = self.curve.model.nearest(&c);
+            let gap = n.distance - r;
+            // Newton from above a face that bulges up stays above the contact: close enough is
+            // a contact too.
+            if gap <= self.curve.stylus.target() {
+                return Descent::Contact { below: z, above };
+            }
+            above = Some((z, gap));
+            let up = n.direction(&c).z;
+            z -= if up > 0.2 { (gap / up).min(gap + least) } else { gap.max(least) };
+        }
+        Descent::Clear
+    }
+
+    /// The contact between a height inside (|L| < r at `below`) and one outside (`above`, with
+    /// its |L| − r), by regula falsi (Illinois) on |L| − r down to the correction target.
+    fn settle(&self, s: f64, below: f64, above: Option<(f64, f64)>) -> Option<CurvePoint> {
+        let stylus = self.curve.stylus;
+        let target = stylus.target();
+        let at = |z: f64| {
+            let c = self.line.at(s, z);
+            let n = self.curve.model.nearest(&c);
+            (c, n, n.distance - stylus.radius)
+        };
+        let (c, n, gap) = at(below);
+        if gap.abs() <= target || above.is_none() {
+            return if n.converged && gap.abs() <= stylus.contact_tol { self.curve.finish(c, &n, 1) } else { None };
+        }
+        let ((mut z0, mut f0), (mut z1, mut f1)) = ((below, gap), above.expect("checked above"));
+        let mut side = 0;
+        for it in 1..=200 {
+            let z = if f1 - f0 != 0.0 { z0 - f0 * (z1 - z0) / (f1 - f0) } else { 0.5 * (z0 + z1) };
+            let z = if z > z0.min(z1) && z < z0.max(z1) { z } else { 0.5 * (z0 + z1) };
+            let (c, n, f) = at(z);
+            if f.abs() <= target || (z1 - z0).abs() < 1e-13 * (1.0 + z.abs()) {
+                return (n.converged && f.abs() <= stylus.contact_tol).then(|| self.curve.finish(c, &n, it)).flatten();
+            }
+            if f < 0.0 {
+                (z0, f0) = (z, f);
+                if side == -1 {
+                    f1 *= 0.5;
+                }
+                side = -1;
+            } else {
+                (z1, f1) = (z, f);
+                if side == 1 {
+                    f0 *= 0.5;
+                }
+                side = 1;
+            }
+        }
+        None
+    }
+
+    /// One pass from `start` along the envelope; the pass and the parameter where it ends.
+    fn follow(&self, start: CurvePoint) -> (TracedPath, f64) {
+        let (line, steps) = (self.line, self.steps);
         let mut pts = vec![start];
         let mut h = steps.max_step * 0.25;
         let mut deviation: f64 = 0.0;
@@ -115,66 +263,99 @@ pub fn trace_line(
         let mut interrupted = false;
         loop {
             let a = *pts.last().expect("a pass has a start");
-            let sa = line.s_of(&a.cl.centre);
+            let sa = self.s_of(&a);
             if sa >= line.s1 - camkit::tol::POINT_EPS {
                 break;
             }
-            // Overhang: the curve turns back under the model; this pass ends here.
-            if a.tangent.dot(&line.dir) < -1e-6 {
-                ended_at = sa;
-                break;
-            }
-            let Some(st) = step(&curve, &a, h, steps) else {
-                // The stylus loses the model (it slides off a sheet's side): the pass ends here
-                // and the stylus is dropped again farther on.
-                ended_at = sa;
-                interrupted = true;
-                break;
-            };
-            let mut next = st.to;
-            if line.s_of(&next.cl.centre) > line.s1 {
-                // The last point lies on the region's end: drop onto the curve there.
-                let t = (line.s1 - sa) / (line.s_of(&next.cl.centre) - sa);
-                let guess = a.cl.centre + (next.cl.centre - a.cl.centre) * t;
-                match curve.correct(&P3::new(guess.x, guess.y, guess.z.max(next.cl.centre.z)), &line.dir) {
-                    Some(end) => next = end,
-                    None => {
-                        next = st.to;
+            let (mut next, dev, next_h) = match step(&self.curve, &a, h, steps) {
+                Some(st) if self.on_envelope(&a, &st.to) => (st.to, st.deviation, st.next),
+                Some(st) => {
+                    // It left the envelope within this step: end the pass where it does.
+                    if let Some(b) = self.boundary(&a, (st.to.cl.centre - a.cl.centre).norm()) {
+                        pts.push(b);
                     }
+                    ended_at = self.s_of(pts.last().expect("a pass has a start"));
+                    break;
+                }
+                None => match self.drop_step(&a, h) {
+                    Some(found) => found,
+                    None => {
+                        // Neither copying nor drops go on: the envelope jumps here.
+                        ended_at = sa;
+                        interrupted = true;
+                        break;
+                    }
+                },
+            };
+            if self.s_of(&next) > line.s1 {
+                // The last point lies on the region's end: drop onto the curve there.
+                let t = (line.s1 - sa) / (self.s_of(&next) - sa);
+                let guess = a.cl.centre + (next.cl.centre - a.cl.centre) * t;
+                if let Some(end) = self
+                    .curve
+                    .correct(&P3::new(guess.x, guess.y, guess.z.max(next.cl.centre.z)), &line.dir)
+                    .or_else(|| self.land(line.s1))
+                {
+                    next = end;
                 }
             }
-            deviation = deviation.max(st.deviation);
-            h = st.next;
+            deviation = deviation.max(dev);
+            h = next_h;
             pts.push(next);
         }
-        paths.push(TracedPath { points: pts.into_iter().map(|p| p.cl).collect(), deviation, interrupted, unit });
-        // Always onwards: a drop's correction may have landed behind where it was dropped.
-        s = if ended_at >= line.s1 { f64::INFINITY } else { ended_at.max(s) + steps.min_step.max(1e-3) };
+        let pass = TracedPath { points: pts.into_iter().map(|p| p.cl).collect(), deviation, interrupted, unit: 0 };
+        (pass, ended_at)
     }
-    Ok(paths)
+
+    /// The farthest point on the envelope from `a` along its tangent, the step of length `bad`
+    /// having left it: bisection on the step length down to the shortest step.
+    fn boundary(&self, a: &CurvePoint, bad: f64) -> Option<CurvePoint> {
+        let (mut lo, mut hi, mut best) = (0.0, bad, None);
+        while hi - lo > self.steps.min_step {
+            let mid = 0.5 * (lo + hi);
+            let p = self
+                .curve
+                .correct(&(a.cl.centre + a.tangent * mid), &a.tangent)
+                .filter(|p| (p.cl.centre - a.cl.centre).dot(&a.tangent) > 0.0 && self.on_envelope(a, p));
+            match p {
+                Some(p) => {
+                    lo = mid;
+                    best = Some(p);
+                }
+                None => hi = mid,
+            }
+        }
+        best
+    }
+
+    /// A step by drops where copying cannot go on: the stylus dropped `h` on (shortened down to
+    /// the shortest step) is taken when the drop halfway lies within the chord tolerance of the
+    /// chord. The new point, its chord deviation and the next step length.
+    fn drop_step(&self, a: &CurvePoint, h: f64) -> Option<(CurvePoint, f64, f64)> {
+        let (steps, sa) = (self.steps, self.s_of(a));
+        let mut h = h.clamp(steps.min_step, steps.max_step);
+        loop {
+            let sb = (sa + h).min(self.line.s1);
+            if let (Some(b), Some(m)) = (self.land(sb), self.land(0.5 * (sa + sb))) {
+                let mid = a.cl.centre + (b.cl.centre - a.cl.centre) * 0.5;
+                let dev = (m.cl.centre.z - mid.z).abs();
+                if dev <= steps.chord_tol * AIM && self.s_of(&b) > sa {
+                    return Some((b, dev, (2.0 * h).min(steps.max_step)));
+                }
+            }
+            if h <= steps.min_step {
+                return None;
+            }
+            h = (h * 0.5).max(steps.min_step);
+        }
+    }
 }
 
-/// The stylus dropped from `z_top` at `s` onto the first contact, or `None` if it falls past
-/// `z_bottom`. Sphere tracing (steps of |L| − r never pass through the model, |L| being
-/// 1-Lipschitz) brings it close; a vertical Newton correction lands it.
-fn drop(curve: &PlaneCurve, line: &Line, s: f64, z_top: f64, z_bottom: f64) -> Option<CurvePoint> {
-    let r = curve.stylus.radius;
-    // Beside a vertical wall |L| − r stays small without a contact below; a step this long can
-    // pass a contact only by a depth of step²/8r, the contact tolerance.
-    let least = (8.0 * r * curve.stylus.contact_tol).sqrt();
-    let mut z = z_top;
-    for _ in 0..100_000 {
-        let c = line.at(s, z);
-        let n = curve.model.nearest(&c);
-        let gap = n.distance - r;
-        if gap <= 0.05 * r && n.direction(&c).z.abs() >= 0.2 {
-            let p = curve.correct(&c, &line.dir)?;
-            return (p.cl.centre.z >= z_bottom).then_some(p);
-        }
-        z -= gap.max(least);
-        if z < z_bottom {
-            return None;
-        }
-    }
-    None
+/// The end of a drop.
+enum Descent {
+    /// The stylus met the model: a height inside it (or within the target of touching) and the
+    /// last one outside with its |L| − r.
+    Contact { below: f64, above: Option<(f64, f64)> },
+    /// It went down past the stop without touching.
+    Clear,
 }
