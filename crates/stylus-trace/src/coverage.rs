@@ -1,9 +1,11 @@
 //! The coverage check of scan mode: every scan line's written CL points against an independent
 //! drop of the stylus ([`crate::envelope`]) at the line's sample positions. A line is covered when
 //! no stretch longer than the gap tolerance, with the model under it, lies outside every pass,
-//! and no CL point lies below the upper envelope by more than the envelope tolerance (the
-//! envelope taken as its lowest over ±that tolerance along the line, so a pass climbing a vertical
-//! wall at a step of the envelope is not counted).
+//! and no CL point lies below the upper envelope by more than the envelope tolerance, measured
+//! across the envelope (the vertical depth times the z of the envelope's normal there), and with
+//! the envelope taken as its lowest within that tolerance horizontally, so a pass climbing a
+//! vertical wall at a step of the envelope, or a point off a steep face of it within the contact
+//! tolerance, is not counted. The depth reported is vertical.
 
 use crate::TracedPath;
 use crate::envelope::Dropper;
@@ -11,6 +13,10 @@ use crate::scan::{self, Line, Scan};
 use camkit::geom::P3;
 use camkit::model::Model;
 use rayon::prelude::*;
+
+/// Points around a CL point, on a circle of the envelope tolerance, where the envelope is also
+/// dropped: a point is below the envelope only if it is below all of them.
+const NEIGHBOURS: usize = 8;
 
 /// What the check asks.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -74,7 +80,7 @@ pub fn check(
                 .filter(|p| p.unit == k)
                 .map(|p| p.points.iter().map(|q| q.centre.map(round)).collect())
                 .collect();
-            check_line(&dropper, k, line, &written, tol)
+            check_line(model, &dropper, k, line, &written, tol)
         })
         .collect();
     let mut out = Coverage { lines: lines.len(), ..Coverage::default() };
@@ -88,6 +94,14 @@ pub fn check(
     out
 }
 
+/// The z of the unit normal of the envelope at a stylus centre on it: from the model's nearest
+/// point (the tolerance's scale only; the envelope itself comes from the drop).
+fn slope(model: &Model, x: f64, y: f64, z: f64) -> f64 {
+    let c = P3::new(x, y, z);
+    model.nearest(&c).direction(&c).z.abs()
+}
+
+/// One line's figures.
 #[derive(Default)]
 struct LineFigures {
     drops: usize,
@@ -97,7 +111,7 @@ struct LineFigures {
     defects: Vec<Defect>,
 }
 
-fn check_line(d: &Dropper, k: usize, line: &Line, passes: &[Vec<P3>], tol: &Tolerances) -> LineFigures {
+fn check_line(model: &Model, d: &Dropper, k: usize, line: &Line, passes: &[Vec<P3>], tol: &Tolerances) -> LineFigures {
     let mut f = LineFigures::default();
     let at = |s: f64| line.at(s, 0.0);
     let drop = |s: f64, f: &mut LineFigures| {
@@ -169,26 +183,29 @@ fn check_line(d: &Dropper, k: usize, line: &Line, passes: &[Vec<P3>], tol: &Tole
                 line: k,
                 from: at(lo),
                 to: at(hi),
-                what: format!("the model is under it but no pass covers {gap:.3} mm"),
+                what: format!("the model is under it but no pass covers {gap:.4} mm"),
             });
         }
     }
-    // Written points against the envelope, lowest over ±the tolerance along the line.
+    // Written points against the envelope, its lowest within the tolerance around them.
     let mut below: Option<(P3, P3, f64, usize)> = None;
     for p in passes.iter().flatten() {
         let s = line.s_of(p);
         let mut env = f64::INFINITY;
         // The neighbours only matter when the point is below the envelope right over it.
-        for ds in [0.0, -tol.below, tol.below] {
+        for k in 0..=NEIGHBOURS {
             if env - p.z <= tol.below {
                 break;
             }
-            let q = P3::new(p.x, p.y, 0.0) + line.dir * ds;
+            let (dy, dx) = (k as f64 / NEIGHBOURS as f64 * std::f64::consts::TAU).sin_cos();
+            let e = if k == 0 { 0.0 } else { tol.below };
             f.drops += 1;
-            env = env.min(d.drop(q.x, q.y).unwrap_or(-f64::INFINITY));
+            env = env.min(d.drop(p.x + dx * e, p.y + dy * e).unwrap_or(-f64::INFINITY));
         }
         let depth = env - p.z;
-        if depth > tol.below {
+        // Measured across the envelope (depth × its normal's z there): a point within the
+        // contact tolerance of a steep face of it is not below.
+        if depth > tol.below && depth * slope(model, p.x, p.y, env) > tol.below {
             f.below += 1;
             f.largest_below = f.largest_below.max(depth);
             let here = at(s);
@@ -203,7 +220,7 @@ fn check_line(d: &Dropper, k: usize, line: &Line, passes: &[Vec<P3>], tol: &Tole
             line: k,
             from,
             to,
-            what: format!("{n} CL points lie below the stylus's upper envelope, by up to {depth:.3} mm"),
+            what: format!("{n} CL points lie below the stylus's upper envelope, by up to {depth:.4} mm"),
         });
     }
     f

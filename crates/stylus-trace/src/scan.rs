@@ -119,16 +119,19 @@ pub fn trace_line(
     };
     let hop = (steps.chord_tol * 0.5).max(steps.min_step);
     let t = Tracer { curve, line, steps, z_top, z_bottom, hop };
-    // Where nothing is under the stylus, look again this far on.
-    let probe = steps.max_step.min(stylus.radius * 0.5);
     let mut paths = Vec::new();
     let mut s = line.s0;
     let mut missed: Option<f64> = None;
     while s <= line.s1 {
-        let Some(mut start) = t.land(s) else {
-            missed = Some(s);
-            s = if s < line.s1 { (s + probe).min(line.s1) } else { f64::INFINITY };
-            continue;
+        let mut start = match t.land_or_clear(s) {
+            Ok(p) => p,
+            Err(clear) => {
+                // Nothing is under the stylus, nor within `clear` of it: look again that far
+                // on (a shadow shorter than the hop may be passed over).
+                missed = Some(s);
+                s = if s < line.s1 { (s + clear.max(t.hop)).min(line.s1) } else { f64::INFINITY };
+                continue;
+            }
         };
         // After a miss, the model's shadow begins somewhere before s: find it.
         if let Some(mut m) = missed.take() {
@@ -159,28 +162,39 @@ impl Tracer<'_> {
 
     /// True when `b`, reached from `a`, is on the upper envelope: it touches from above or from
     /// the side (the tangent does not turn back), it does not go back along the line, and no
-    /// part of the model lies over it (checked where the contact faces up; a pass climbing a
-    /// vertical wall is left to the coverage check).
+    /// part of the model lies over it: a drop from the top meets nothing above it where its
+    /// contact faces up, and lands on it (across the envelope, within ten contact tolerances)
+    /// where the face is steep. A pass climbing a vertical wall (a step of the envelope) goes on.
     fn on_envelope(&self, a: &CurvePoint, b: &CurvePoint) -> bool {
         let back = 1e-9;
         if b.tangent.dot(&self.line.dir) < -back || self.s_of(b) < self.s_of(a) - back {
             return false;
         }
-        let up = b.cl.normal.z;
-        if up < 0.05 {
+        let (up, c, tol) = (b.cl.normal.z, b.cl.centre, 10.0 * self.curve.stylus.contact_tol);
+        if up <= 1e-6 {
             return true;
         }
-        let margin = 10.0 * self.curve.stylus.contact_tol / up;
-        let c = b.cl.centre;
-        !matches!(self.descend(c.x, c.y, c.z + margin), Descent::Contact { .. })
+        if up >= 0.05 {
+            return !matches!(self.descend(c.x, c.y, c.z + tol / up), Descent::Contact { .. });
+        }
+        match self.land_or_clear(self.s_of(b)) {
+            Ok(top) => (top.cl.centre.z - c.z) * top.cl.normal.z.abs() <= tol,
+            Err(_) => true,
+        }
     }
 
     /// The stylus dropped at `s` onto its highest contact, or `None` if nothing is under it.
     fn land(&self, s: f64) -> Option<CurvePoint> {
+        self.land_or_clear(s).ok()
+    }
+
+    /// The stylus dropped at `s` onto its highest contact, or how far it is clear of the model
+    /// (a lower bound of |L| − r down the whole column; 0 if it touched but did not settle).
+    fn land_or_clear(&self, s: f64) -> Result<CurvePoint, f64> {
         let p = self.line.at(s, 0.0);
         match self.descend(p.x, p.y, self.z_bottom) {
-            Descent::Contact { below, above } => self.settle(s, below, above),
-            Descent::Clear => None,
+            Descent::Contact { below, above } => self.settle(s, below, above).ok_or(0.0),
+            Descent::Clear { margin } => Err(margin),
         }
     }
 
@@ -192,25 +206,33 @@ impl Tracer<'_> {
     fn descend(&self, x: f64, y: f64, z_stop: f64) -> Descent {
         let (r, tol) = (self.curve.stylus.radius, self.curve.stylus.contact_tol);
         let least = (8.0 * r * tol).sqrt();
-        let mut z = self.z_top;
-        let mut above = None;
-        for _ in 0..100_000 {
-            if z < z_stop {
-                return Descent::Clear;
-            }
+        let gap_at = |z: f64| {
             let c = P3::new(x, y, z);
             let n = self.curve.model.nearest(&c);
-            let gap = n.distance - r;
+            (n.distance - r, n.direction(&c).z)
+        };
+        let mut z = self.z_top;
+        let mut above: Option<(f64, f64)> = None;
+        // A lower bound of |L| − r over the column searched so far: between heights a step h
+        // apart with gaps g₀, g₁ it is at least (g₀ + g₁ − h)/2, |L| being 1-Lipschitz.
+        let mut margin = f64::INFINITY;
+        for _ in 0..100_000 {
+            let (gap, up) = gap_at(z.max(z_stop));
+            if let Some((za, ga)) = above {
+                margin = margin.min(0.5 * (ga + gap - (za - z.max(z_stop))));
+            }
+            if z <= z_stop {
+                return Descent::Clear { margin: margin.max(0.0) };
+            }
             // Newton from above a face that bulges up stays above the contact: close enough is
             // a contact too.
             if gap <= self.curve.stylus.target() {
                 return Descent::Contact { below: z, above };
             }
             above = Some((z, gap));
-            let up = n.direction(&c).z;
             z -= if up > 0.2 { (gap / up).min(gap + least) } else { gap.max(least) };
         }
-        Descent::Clear
+        Descent::Clear { margin: 0.0 }
     }
 
     /// The contact between a height inside (|L| < r at `below`) and one outside (`above`, with
@@ -356,6 +378,10 @@ enum Descent {
     /// The stylus met the model: a height inside it (or within the target of touching) and the
     /// last one outside with its |L| − r.
     Contact { below: f64, above: Option<(f64, f64)> },
-    /// It went down past the stop without touching.
-    Clear,
+    /// It went down to the stop without touching; |L| − r was at least `margin` all the way,
+    /// so no column within that distance horizontally touches either.
+    Clear {
+        /// Lower bound of |L| − r along the column.
+        margin: f64,
+    },
 }
