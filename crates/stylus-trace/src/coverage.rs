@@ -225,3 +225,62 @@ fn check_line(model: &Model, d: &Dropper, k: usize, line: &Line, passes: &[Vec<P
     }
     f
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::Region;
+    use crate::curve::ClPoint;
+    use camkit::geom::V3;
+    use camkit::io::Input;
+
+    fn point(x: f64, y: f64, z: f64) -> ClPoint {
+        let c = P3::new(x, y, z);
+        ClPoint {
+            centre: c,
+            contact: c,
+            normal: V3::z(),
+            surface: 0,
+            second: None,
+            iterations: 1,
+            residual: 0.0,
+            front: true,
+        }
+    }
+
+    /// A floor and a floating ball, r = 5: lines that run along the floor under the ball, one of
+    /// them left half-traced, are named with their stretches.
+    #[test]
+    fn finds_gaps_and_points_under_the_envelope() {
+        let m = Model::load(&Input {
+            name: "m.json".into(),
+            data: br#"{"surfaces": [{"type": "plane", "point": [0,0,0], "normal": [0,0,1]},
+                                    {"type": "sphere", "centre": [50,0,30], "radius": 10}]}"#
+                .to_vec(),
+        })
+        .unwrap();
+        let scan =
+            Scan { region: Region { x0: 20.0, x1: 80.0, y0: 0.0, y1: 4.0 }, angle: 0.0, pick: 4.0, zigzag: false };
+        let pass = |y: f64, x0: f64, x1: f64, unit: usize| TracedPath {
+            points: (0..=60).map(|k| point(x0 + (x1 - x0) * k as f64 / 60.0, y, 5.0)).collect(),
+            deviation: 0.0,
+            interrupted: false,
+            unit,
+        };
+        // Line 0 (y = 0) along the floor right through under the ball; line 1 (y = 4) only to 50.
+        let paths = [pass(0.0, 20.0, 80.0, 0), pass(4.0, 20.0, 50.0, 1)];
+        let tol = Tolerances { gap: 1e-3, below: 1e-4, spacing: 1.0 };
+        let c = check(&m, 5.0, &scan, &paths, &tol, &|v| v);
+        assert_eq!(c.lines, 2);
+        assert!((c.largest_gap - 30.0).abs() < 1e-9, "{c:?}");
+        // Under the ball (within 15 of its axis, the top 15 above its centre): 29 points of each
+        // line, x 36..64 on y = 0 and 36..50 on y = 4.
+        assert_eq!(c.points_below, 58, "{c:?}");
+        assert!((c.largest_below - 40.0).abs() < 1e-9, "{c:?}");
+        assert_eq!(c.defects.len(), 3, "{:?}", c.defects);
+        let gap = c.defects.iter().find(|d| d.line == 1 && d.what.contains("no pass")).unwrap();
+        assert_eq!((gap.from.x, gap.to.x), (50.0, 80.0));
+        let under = c.defects.iter().find(|d| d.line == 0).unwrap();
+        assert_eq!((under.from.x, under.to.x), (36.0, 64.0));
+    }
+}

@@ -332,6 +332,40 @@ mod tests {
     }
 
     #[test]
+    fn mesh_grid_agrees_with_every_triangle() {
+        // A wavy height field with a tilted, placed copy: the grid's candidates hold every
+        // triangle that matters, and the placement is applied.
+        let f = |i: usize, j: usize| {
+            let (x, y) = (i as f64 * 2.0, j as f64 * 2.0);
+            P3::new(x, y, (x * 0.4).sin() * 3.0 + (y * 0.3).cos() * 2.0)
+        };
+        let mut tris = Vec::new();
+        for i in 0..15 {
+            for j in 0..15 {
+                tris.push([f(i, j), f(i + 1, j), f(i + 1, j + 1)]);
+                tris.push([f(i, j), f(i + 1, j + 1), f(i, j + 1)]);
+            }
+        }
+        let stl = camkit::model::mesh::binary_stl(&tris);
+        let m = Model::load(&Input { name: "w.stl".into(), data: stl }).unwrap();
+        let stored: Vec<Tri> = match &m.surfaces[0].geometry {
+            Geometry::Mesh(mesh) => {
+                mesh.corners().map(|p| Tri { p, n: (p[1] - p[0]).cross(&(p[2] - p[0])).normalize() }).collect()
+            }
+            _ => unreachable!("a mesh"),
+        };
+        let d = Dropper::new(&m, 1.7, 1e-7);
+        for k in 0..400 {
+            let (x, y) = ((k as f64 * 0.618).fract() * 34.0 - 2.0, (k as f64 * 0.377).fract() * 34.0 - 2.0);
+            let brute = stored
+                .iter()
+                .filter_map(|t| drop_on_triangle(t, x, y, 1.7))
+                .fold(None, |b: Option<f64>, z| Some(b.map_or(z, |b| b.max(z))));
+            assert_eq!(d.drop(x, y), brute, "at ({x}, {y})");
+        }
+    }
+
+    #[test]
     fn triangle_facet_edge_corner() {
         let t = Tri { p: [P3::origin(), P3::new(10.0, 0.0, 0.0), P3::new(0.0, 10.0, 0.0)], n: V3::z() };
         assert_eq!(drop_on_triangle(&t, 2.0, 2.0, 1.0), Some(1.0));

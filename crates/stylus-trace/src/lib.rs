@@ -59,8 +59,8 @@ pub struct TracedPath {
     pub points: Vec<ClPoint>,
     /// Largest estimated chord deviation of its steps (mm).
     pub deviation: f64,
-    /// True when the pass ended because the stylus could not follow the model any further
-    /// (scan mode: it slid off the side of a sheet); the next pass starts beyond.
+    /// True when the pass ended because the stylus could not follow the model any further (scan
+    /// mode: neither copying nor drops go on, the envelope jumps); the next pass starts beyond.
     pub interrupted: bool,
     /// The unit of work it belongs to (scan line, contour level; 0 in two-surface mode).
     pub unit: usize,

@@ -290,7 +290,7 @@ fn run(args: Args) -> Result<()> {
     let interrupted = paths.iter().filter(|p| p.interrupted).count();
     if interrupted > 0 {
         cli::warn(&format!(
-            "{interrupted} passes end where the stylus could not follow the model (off the side of a sheet); the next pass starts beyond"
+            "{interrupted} passes end where neither copying nor drops could follow the envelope (a jump); the next pass starts --chord-tol/2 on"
         ));
     }
     let tag = opts.mode.tag();
