@@ -5,7 +5,8 @@
 //! across the envelope (the vertical depth times the z of the envelope's normal there), and with
 //! the envelope taken as its lowest within that tolerance horizontally, so a pass climbing a
 //! vertical wall at a step of the envelope, or a point off a steep face of it within the contact
-//! tolerance, is not counted. The depth reported is vertical.
+//! tolerance, is not counted. The chords between written points are checked the same way at the
+//! sample positions, against the chord tolerance. Depths reported are vertical.
 
 use crate::TracedPath;
 use crate::envelope::Dropper;
@@ -25,6 +26,8 @@ pub struct Tolerances {
     pub gap: f64,
     /// Deepest a written point may lie below the envelope (mm).
     pub below: f64,
+    /// Deepest a chord between written points may run below the envelope (mm).
+    pub chord: f64,
     /// Spacing of the sample positions along a line (mm).
     pub spacing: f64,
 }
@@ -55,6 +58,12 @@ pub struct Coverage {
     pub points_below: usize,
     /// Largest depth of a written point below the envelope (mm; 0 when none is below).
     pub largest_below: f64,
+    /// Positions inside chords checked.
+    pub chord_samples: usize,
+    /// Of them, those where the chord runs below the envelope by more than the chord tolerance.
+    pub chords_below: usize,
+    /// Largest depth of a chord below the envelope among them (mm; 0 when none is).
+    pub largest_chord_below: f64,
     /// The failing stretches, in line order.
     pub defects: Vec<Defect>,
 }
@@ -89,6 +98,9 @@ pub fn check(
         out.largest_gap = out.largest_gap.max(f.largest_gap);
         out.points_below += f.below;
         out.largest_below = out.largest_below.max(f.largest_below);
+        out.chord_samples += f.chord_samples;
+        out.chords_below += f.chords_below;
+        out.largest_chord_below = out.largest_chord_below.max(f.largest_chord_below);
         out.defects.extend(f.defects);
     }
     out
@@ -108,6 +120,9 @@ struct LineFigures {
     largest_gap: f64,
     below: usize,
     largest_below: f64,
+    chord_samples: usize,
+    chords_below: usize,
+    largest_chord_below: f64,
     defects: Vec<Defect>,
 }
 
@@ -190,25 +205,10 @@ fn check_line(model: &Model, d: &Dropper, k: usize, line: &Line, passes: &[Vec<P
     // Written points against the envelope, its lowest within the tolerance around them.
     let mut below: Option<(P3, P3, f64, usize)> = None;
     for p in passes.iter().flatten() {
-        let s = line.s_of(p);
-        let mut env = f64::INFINITY;
-        // The neighbours only matter when the point is below the envelope right over it.
-        for k in 0..=NEIGHBOURS {
-            if env - p.z <= tol.below {
-                break;
-            }
-            let (dy, dx) = (k as f64 / NEIGHBOURS as f64 * std::f64::consts::TAU).sin_cos();
-            let e = if k == 0 { 0.0 } else { tol.below };
-            f.drops += 1;
-            env = env.min(d.drop(p.x + dx * e, p.y + dy * e).unwrap_or(-f64::INFINITY));
-        }
-        let depth = env - p.z;
-        // Measured across the envelope (depth × its normal's z there): a point within the
-        // contact tolerance of a steep face of it is not below.
-        if depth > tol.below && depth * slope(model, p.x, p.y, env) > tol.below {
+        if let Some(depth) = depth_below(model, d, p, tol.below, &mut f.drops) {
             f.below += 1;
             f.largest_below = f.largest_below.max(depth);
-            let here = at(s);
+            let here = at(line.s_of(p));
             below = Some(match below {
                 None => (here, here, depth, 1),
                 Some((a, _, m, n)) => (a, here, m.max(depth), n + 1),
@@ -223,7 +223,64 @@ fn check_line(model: &Model, d: &Dropper, k: usize, line: &Line, passes: &[Vec<P
             what: format!("{n} CL points lie below the stylus's upper envelope, by up to {depth:.4} mm"),
         });
     }
+    // The chords between them at the sample positions, against the chord tolerance.
+    let mut under: Option<(P3, P3, f64)> = None;
+    for pass in passes {
+        for w in pass.windows(2) {
+            let (sa, sb) = (line.s_of(&w[0]), line.s_of(&w[1]));
+            if sb - sa <= 0.0 {
+                continue;
+            }
+            let mut j = ((sa - line.s0) / tol.spacing).floor() as i64 + 1;
+            while line.s0 + j as f64 * tol.spacing < sb {
+                let s = line.s0 + j as f64 * tol.spacing;
+                j += 1;
+                if s <= sa {
+                    continue;
+                }
+                let q = w[0] + (w[1] - w[0]) * ((s - sa) / (sb - sa));
+                f.chord_samples += 1;
+                if let Some(depth) = depth_below(model, d, &q, tol.chord, &mut f.drops) {
+                    f.chords_below += 1;
+                    f.largest_chord_below = f.largest_chord_below.max(depth);
+                    under = Some(match under {
+                        None => (at(s), at(s), depth),
+                        Some((a, _, m)) => (a, at(s), m.max(depth)),
+                    });
+                }
+            }
+        }
+    }
+    if let Some((from, to, depth)) = under {
+        f.defects.push(Defect {
+            line: k,
+            from,
+            to,
+            what: format!("between CL points the path runs below the stylus's upper envelope, by up to {depth:.4} mm"),
+        });
+    }
     f
+}
+
+/// How far `p` lies below the envelope (vertically) when it does by more than `tol`, measured
+/// across the envelope (the depth times the z of its normal there, so a point within `tol` of a
+/// steep face of it is not below), with the envelope taken as its lowest over `p`'s column and a
+/// circle of radius `tol` round it (a pass climbing a vertical wall, a step of the envelope, is
+/// not below). `drops` counts the drops made.
+fn depth_below(model: &Model, d: &Dropper, p: &P3, tol: f64, drops: &mut usize) -> Option<f64> {
+    let mut env = f64::INFINITY;
+    // The neighbours only matter when the point is below the envelope right over it.
+    for k in 0..=NEIGHBOURS {
+        if env - p.z <= tol {
+            return None;
+        }
+        let (dy, dx) = (k as f64 / NEIGHBOURS as f64 * std::f64::consts::TAU).sin_cos();
+        let e = if k == 0 { 0.0 } else { tol };
+        *drops += 1;
+        env = env.min(d.drop(p.x + dx * e, p.y + dy * e).unwrap_or(-f64::INFINITY));
+    }
+    let depth = env - p.z;
+    (depth > tol && depth * slope(model, p.x, p.y, env) > tol).then_some(depth)
 }
 
 #[cfg(test)]
@@ -269,7 +326,7 @@ mod tests {
         };
         // Line 0 (y = 0) along the floor right through under the ball; line 1 (y = 4) only to 50.
         let paths = [pass(0.0, 20.0, 80.0, 0), pass(4.0, 20.0, 50.0, 1)];
-        let tol = Tolerances { gap: 1e-3, below: 1e-4, spacing: 1.0 };
+        let tol = Tolerances { gap: 1e-3, below: 1e-4, chord: 1.1e-3, spacing: 0.3 };
         let c = check(&m, 5.0, &scan, &paths, &tol, &|v| v);
         assert_eq!(c.lines, 2);
         assert!((c.largest_gap - 30.0).abs() < 1e-9, "{c:?}");
@@ -277,7 +334,10 @@ mod tests {
         // line, x 36..64 on y = 0 and 36..50 on y = 4.
         assert_eq!(c.points_below, 58, "{c:?}");
         assert!((c.largest_below - 40.0).abs() < 1e-9, "{c:?}");
-        assert_eq!(c.defects.len(), 3, "{:?}", c.defects);
+        // The chords under the ball too, sampled every 0.3 mm.
+        assert!(c.chord_samples > 250 && c.chords_below > 100, "{c:?}");
+        assert!(c.largest_chord_below > 39.9, "{c:?}");
+        assert_eq!(c.defects.len(), 5, "{:?}", c.defects);
         let gap = c.defects.iter().find(|d| d.line == 1 && d.what.contains("no pass")).unwrap();
         assert_eq!((gap.from.x, gap.to.x), (50.0, 80.0));
         let under = c.defects.iter().find(|d| d.line == 0).unwrap();

@@ -343,6 +343,10 @@ fn run(args: Args) -> Result<()> {
                 .set("envelope_tol_mm", tol.below)
                 .set("points_below_envelope", c.points_below)
                 .set("largest_below_envelope_mm", c.largest_below)
+                .set("chord_tol_below_envelope_mm", tol.chord)
+                .set("chord_samples", c.chord_samples)
+                .set("chord_samples_below_envelope", c.chords_below)
+                .set("largest_chord_below_envelope_mm", c.largest_chord_below)
                 .set("lines_not_covered", lines_failing(c));
         }
         r.write(path)?;
@@ -350,12 +354,14 @@ fn run(args: Args) -> Result<()> {
     out.commit()?;
     match &coverage {
         Some((c, _)) if !c.defects.is_empty() => Err(Error::check(format!(
-            "{} of {} scan lines fail the coverage check (largest gap {:.3} mm, {} points below the envelope by up to {:.3} mm)",
+            "{} of {} scan lines fail the coverage check (largest gap {:.4} mm, {} points below the envelope by up to {:.4} mm, chords at {} positions by up to {:.4} mm)",
             lines_failing(c),
             c.lines,
             c.largest_gap,
             c.points_below,
-            c.largest_below
+            c.largest_below,
+            c.chords_below,
+            c.largest_chord_below
         ))),
         _ => Ok(()),
     }
@@ -384,7 +390,8 @@ fn check_coverage(
     let tol = Tolerances {
         gap: opts.steps.chord_tol,
         below: opts.stylus.contact_tol + unit,
-        spacing: opts.steps.max_step.min(0.25 * opts.stylus.radius),
+        chord: opts.steps.chord_tol + opts.stylus.contact_tol + unit,
+        spacing: stylus_trace::scan::sample_spacing(&opts.stylus, &opts.steps),
     };
     let round = |v: f64| decimals.map_or(v, |d| round_to(v, d));
     let c = coverage::check(model, opts.stylus.radius, scan, paths, &tol, &round);

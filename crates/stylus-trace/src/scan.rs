@@ -99,6 +99,14 @@ struct Tracer<'a> {
     /// How far past a pass's end the stylus is dropped again (below the coverage check's gap
     /// tolerance, the chord tolerance).
     hop: f64,
+    /// Spacing of the sample positions along the line where chords are checked.
+    spacing: f64,
+}
+
+/// Spacing of the positions along a scan line where the chords between CL points are checked
+/// against the envelope, by the tracer and by the coverage check alike: min(longest step, r/4).
+pub fn sample_spacing(stylus: &Stylus, steps: &Steps) -> f64 {
+    steps.max_step.min(0.25 * stylus.radius)
 }
 
 /// Traces line number `unit`; the passes it yields, in order. A pass ends at the region's end,
@@ -118,7 +126,7 @@ pub fn trace_line(
         (1e4, -1e4)
     };
     let hop = (steps.chord_tol * 0.5).max(steps.min_step);
-    let t = Tracer { curve, line, steps, z_top, z_bottom, hop };
+    let t = Tracer { curve, line, steps, z_top, z_bottom, hop, spacing: sample_spacing(&stylus, steps) };
     let mut paths = Vec::new();
     let mut s = line.s0;
     let mut missed: Option<f64> = None;
@@ -180,6 +188,33 @@ impl Tracer<'_> {
         match self.land_or_clear(self.s_of(b)) {
             Ok(top) => (top.cl.centre.z - c.z) * top.cl.normal.z.abs() <= tol,
             Err(_) => true,
+        }
+    }
+
+    /// True when the chord from `a` to `b` runs nowhere below the envelope by more than the chord
+    /// tolerance (across it: the vertical depth times the z of its normal) at the sample positions
+    /// inside it: a part of the model narrower than a step, which copying steps over, ends the
+    /// pass before it.
+    fn chord_clear(&self, a: &CurvePoint, b: &CurvePoint) -> bool {
+        let (sa, sb) = (self.s_of(a), self.s_of(b));
+        let (s0, w) = (self.line.s0, self.spacing);
+        let mut j = ((sa - s0) / w).floor() as i64 + 1;
+        loop {
+            let s = s0 + j as f64 * w;
+            j += 1;
+            if s >= sb {
+                return true;
+            }
+            if s <= sa {
+                continue;
+            }
+            let c = a.cl.centre + (b.cl.centre - a.cl.centre) * ((s - sa) / (sb - sa));
+            if let Descent::Contact { below, above } = self.descend(c.x, c.y, c.z) {
+                match self.settle(s, below, above) {
+                    Some(top) if (top.cl.centre.z - c.z) * top.cl.normal.z.abs() <= self.steps.chord_tol => {}
+                    _ => return false,
+                }
+            }
         }
     }
 
@@ -290,7 +325,9 @@ impl Tracer<'_> {
                 break;
             }
             let (mut next, dev, next_h) = match step(&self.curve, &a, h, steps) {
-                Some(st) if self.on_envelope(&a, &st.to) => (st.to, st.deviation, st.next),
+                Some(st) if self.on_envelope(&a, &st.to) && self.chord_clear(&a, &st.to) => {
+                    (st.to, st.deviation, st.next)
+                }
                 Some(st) => {
                     // It left the envelope within this step: end the pass where it does.
                     if let Some(b) = self.boundary(&a, (st.to.cl.centre - a.cl.centre).norm()) {
@@ -335,10 +372,9 @@ impl Tracer<'_> {
         let (mut lo, mut hi, mut best) = (0.0, bad, None);
         while hi - lo > self.steps.min_step {
             let mid = 0.5 * (lo + hi);
-            let p = self
-                .curve
-                .correct(&(a.cl.centre + a.tangent * mid), &a.tangent)
-                .filter(|p| (p.cl.centre - a.cl.centre).dot(&a.tangent) > 0.0 && self.on_envelope(a, p));
+            let p = self.curve.correct(&(a.cl.centre + a.tangent * mid), &a.tangent).filter(|p| {
+                (p.cl.centre - a.cl.centre).dot(&a.tangent) > 0.0 && self.on_envelope(a, p) && self.chord_clear(a, p)
+            });
             match p {
                 Some(p) => {
                     lo = mid;
@@ -361,7 +397,7 @@ impl Tracer<'_> {
             if let (Some(b), Some(m)) = (self.land(sb), self.land(0.5 * (sa + sb))) {
                 let mid = a.cl.centre + (b.cl.centre - a.cl.centre) * 0.5;
                 let dev = (m.cl.centre.z - mid.z).abs();
-                if dev <= steps.chord_tol * AIM && self.s_of(&b) > sa {
+                if dev <= steps.chord_tol * AIM && self.s_of(&b) > sa && self.chord_clear(a, &b) {
                     return Some((b, dev, (2.0 * h).min(steps.max_step)));
                 }
             }

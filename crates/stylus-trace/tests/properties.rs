@@ -230,10 +230,15 @@ proptest! {
 fn assert_lines_cover(m: &Model, opts: &Options) -> Result<(), TestCaseError> {
     let Mode::Scan(s) = &opts.mode else { unreachable!("a scan") };
     let paths = trace(m, opts, &|| ()).map_err(|f| TestCaseError::fail(format!("{f:?}")))?;
-    let tol = Tolerances { gap: CHORD, below: CONTACT, spacing: 0.25 };
+    let tol = Tolerances {
+        gap: CHORD,
+        below: CONTACT,
+        chord: CHORD + CONTACT,
+        spacing: stylus_trace::scan::sample_spacing(&opts.stylus, &opts.steps),
+    };
     let c = coverage::check(m, opts.stylus.radius, s, &paths, &tol, &|v| v);
     prop_assert!(c.defects.is_empty(), "{:?}", &c.defects[..c.defects.len().min(3)]);
-    prop_assert!(c.largest_gap <= CHORD && c.points_below == 0, "{:?}", c);
+    prop_assert!(c.largest_gap <= CHORD && c.points_below == 0 && c.chords_below == 0, "{:?}", c);
     Ok(())
 }
 
