@@ -716,3 +716,23 @@ fn s4_passes_end_at_the_silhouette_and_start_at_the_shadow() {
     let (gap, below) = coverage_along_x(&cl, -27.0, 33.0, &env);
     assert_covered(&r, gap, below);
 }
+
+#[test]
+fn coverage_is_measured_on_the_rounded_output() {
+    // Rounded to 3 decimals, the 0.5 µm hop between passes at the ball's silhouettes is written
+    // as 1 µm: within the gap tolerance widened by the rounding unit, and measured as written.
+    let w = Work::new();
+    w.write(
+        "bf.json",
+        r#"{"surfaces": [
+ {"type": "plane", "name": "floor", "point": [0, 0, 0], "normal": [0, 0, 1]},
+ {"type": "sphere", "name": "ball", "centre": [50, 0, 30], "radius": 10}]}"#,
+    );
+    let (cl, r, stderr) = scan(&w, "bf.json", &["-r", "5", "--pick", "4", "--region=20,80,-16,16", "--decimals", "3"]);
+    assert_eq!(r["exit_status"], 0, "{stderr}");
+    assert!((r["coverage_gap_tol_mm"].as_f64().unwrap() - 0.002).abs() < 1e-12, "{r}");
+    let gap = r["largest_coverage_gap_mm"].as_f64().unwrap();
+    assert!(gap > 0.0 && gap <= 0.002, "{r}");
+    let (gap_measured, below) = coverage_along_x(&cl, 20.0, 80.0, &floating_ball_envelope);
+    assert!(gap_measured <= 0.002 && below <= 2e-3, "{gap_measured} {below}");
+}

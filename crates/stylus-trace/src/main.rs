@@ -388,7 +388,8 @@ fn check_coverage(
 ) -> (Coverage, Tolerances) {
     let unit = decimals.map_or(0.0, |d| 10f64.powi(-(d as i32)));
     let tol = Tolerances {
-        gap: opts.steps.chord_tol,
+        // Rounding moves each end of a hole by up to half a unit.
+        gap: opts.steps.chord_tol + unit,
         below: opts.stylus.contact_tol + unit,
         chord: opts.steps.chord_tol + opts.stylus.contact_tol + unit,
         spacing: stylus_trace::scan::sample_spacing(&opts.stylus, &opts.steps),
