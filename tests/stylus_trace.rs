@@ -526,10 +526,8 @@ fn drop_on_mesh(tris: &[[P3; 3]], x: f64, y: f64, r: f64) -> Option<f64> {
             let mut top: Option<(f64, f64)> = None;
             for j in 0..=k {
                 let u = u0 + (u1 - u0) * j as f64 / k as f64;
-                if let Some(z) = z_at(u) {
-                    if top.is_none_or(|(_, t)| z > t) {
-                        top = Some((u, z));
-                    }
+                if let Some(z) = z_at(u).filter(|z| top.is_none_or(|(_, t)| *z > t)) {
+                    top = Some((u, z));
                 }
             }
             if let Some((u, _)) = top {
