@@ -106,9 +106,9 @@ pub struct PlaneCurve<'a> {
     pub plane_normal: V3,
     /// Where the offset surface is nearly parallel to the motion plane (|g| below [`MIN_SLOPE`]),
     /// correct anyway along g, each move at most this long (mm), instead of giving up. Contour
-    /// levels near a flat spot need it; scan lines give up there (the stylus slides off a
-    /// sheet's side) and use `None`. The chord check of every step catches a move that lands on
-    /// another branch of the curve.
+    /// levels near a flat spot need it; scan lines give up there (the motion plane is nearly
+    /// tangent to the offset surface: they go on by drops) and use `None`. The chord check of
+    /// every step catches a move that lands on another branch of the curve.
     pub flat_moves: Option<f64>,
 }
 
