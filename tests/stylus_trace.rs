@@ -471,3 +471,266 @@ fn bad_input_gets_one_clear_line_and_no_output() {
     stl("flat.stl").fails(2, "flat.stl (facet 2): degenerate triangle");
     run(r#"{"surfaces": [{"type": "stl", "file": "missing.stl"}]}"#, &["-r", "1"]).fails(2, "(surfaces[0].file)");
 }
+
+// Scan coverage (issue 23): every scan line is the stylus's upper envelope over the model, as
+// an independent drop gives it, wherever the model is under the line.
+
+/// Corners of an STL file as the filter reads them (f32).
+fn stl_corners(path: &std::path::Path) -> Vec<[P3; 3]> {
+    let data = std::fs::read(path).unwrap();
+    camkit::model::mesh::read_stl(&camkit::io::Input { name: "m.stl".into(), data }).unwrap()
+}
+
+/// Highest centre z over (x, y) where a ball of radius r touches one of `tris`, by brute force:
+/// facets (foot inside), edges (foot inside) and corners of every triangle.
+fn drop_on_mesh(tris: &[[P3; 3]], x: f64, y: f64, r: f64) -> Option<f64> {
+    let mut best: Option<f64> = None;
+    let mut take = |z: f64| best = Some(best.map_or(z, |b: f64| b.max(z)));
+    for t in tris {
+        let mut n = (t[1] - t[0]).cross(&(t[2] - t[0])).normalize();
+        if n.z < 0.0 {
+            n = -n;
+        }
+        if n.z > 1e-12 {
+            let z = t[0].z + (r - (x - t[0].x) * n.x - (y - t[0].y) * n.y) / n.z;
+            let f = P3::new(x, y, z) - n * r;
+            let inside = (0..3).all(|i| (t[(i + 1) % 3] - t[i]).cross(&(f - t[i])).dot(&n) >= -1e-12);
+            if inside {
+                take(z);
+            }
+        }
+        for i in 0..3 {
+            let (a, b) = (t[i], t[(i + 1) % 3]);
+            let d2 = (x - a.x).powi(2) + (y - a.y).powi(2);
+            if d2 <= r * r {
+                take(a.z + (r * r - d2).sqrt());
+            }
+            // Edge: the largest over its points p of p.z + sqrt(r² − horizontal²), sampled
+            // over the part within r horizontally (u where a quadratic is ≤ 0) and refined.
+            let (e, w) = ((b - a).xy(), P3::new(x, y, 0.0).xy() - a.xy());
+            let (qa, qb, qc) = (e.norm_squared(), -2.0 * e.dot(&w), w.norm_squared() - r * r);
+            let disc = qb * qb - 4.0 * qa * qc;
+            if qa < 1e-18 || disc < 0.0 {
+                continue;
+            }
+            let (u0, u1) = (((-qb - disc.sqrt()) / (2.0 * qa)).max(0.0), ((-qb + disc.sqrt()) / (2.0 * qa)).min(1.0));
+            if u0 > u1 {
+                continue;
+            }
+            let k = 200;
+            let z_at = |u: f64| {
+                let p = a + (b - a) * u;
+                let h2 = (x - p.x).powi(2) + (y - p.y).powi(2);
+                (h2 <= r * r).then(|| p.z + (r * r - h2).sqrt())
+            };
+            let mut top: Option<(f64, f64)> = None;
+            for j in 0..=k {
+                let u = u0 + (u1 - u0) * j as f64 / k as f64;
+                if let Some(z) = z_at(u).filter(|z| top.is_none_or(|(_, t)| *z > t)) {
+                    top = Some((u, z));
+                }
+            }
+            if let Some((u, _)) = top {
+                // Golden-section refinement around the best sample.
+                let step = (u1 - u0) / k as f64;
+                let (mut lo, mut hi) = ((u - step).max(u0), (u + step).min(u1));
+                for _ in 0..60 {
+                    let (m1, m2) = (lo + (hi - lo) * 0.382, lo + (hi - lo) * 0.618);
+                    if z_at(m1).unwrap_or(f64::NEG_INFINITY) >= z_at(m2).unwrap_or(f64::NEG_INFINITY) {
+                        hi = m2;
+                    } else {
+                        lo = m1;
+                    }
+                }
+                for u in [lo, hi, u] {
+                    if let Some(z) = z_at(u) {
+                        take(z);
+                    }
+                }
+            }
+        }
+    }
+    best
+}
+
+/// Coverage of a scan along x (angle 0) measured against `env` (highest centre z over (x, y),
+/// None where the model is not under): per line y, the longest stretch with the model under it
+/// that no path covers (sampled every 0.005 mm), and the deepest point below the envelope (its
+/// lowest over ±1e-3 mm along the line, so a path climbing a vertical step is not counted).
+fn coverage_along_x(cl: &[Cl], x0: f64, x1: f64, env: &dyn Fn(f64, f64) -> Option<f64>) -> (f64, f64) {
+    let mut ys: Vec<f64> = cl.iter().map(|q| q.c.y).collect();
+    ys.sort_by(f64::total_cmp);
+    ys.dedup();
+    let (mut gap, mut below): (f64, f64) = (0.0, 0.0);
+    for &y in &ys {
+        let on: Vec<&Cl> = cl.iter().filter(|q| q.c.y == y).collect();
+        let mut spans: Vec<(f64, f64)> = Vec::new();
+        for q in &on {
+            match spans.last_mut() {
+                Some(s) if on.iter().any(|p| p.path == q.path && p.c.x == s.0) => s.1 = s.1.max(q.c.x),
+                _ => spans.push((q.c.x, q.c.x)),
+            }
+        }
+        spans.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let mut holes = Vec::new();
+        let mut reach = x0;
+        for (a, b) in spans {
+            if a > reach {
+                holes.push((reach, a));
+            }
+            reach = reach.max(b);
+        }
+        holes.push((reach, x1));
+        for (a, b) in holes {
+            let n = ((b - a) / 0.005).ceil() as usize;
+            let hits: Vec<f64> =
+                (0..=n).map(|k| a + (b - a) * k as f64 / n.max(1) as f64).filter(|&x| env(x, y).is_some()).collect();
+            if let (Some(f), Some(l)) = (hits.first(), hits.last()) {
+                gap = gap.max(l - f);
+            }
+        }
+        for q in &on {
+            let e = [-1e-3, 0.0, 1e-3]
+                .iter()
+                .map(|d| env(q.c.x + d, y).unwrap_or(f64::NEG_INFINITY))
+                .fold(f64::INFINITY, f64::min);
+            below = below.max(e - q.c.z);
+        }
+    }
+    (gap, below)
+}
+
+/// Runs a scan of `input` (a file in the work dir) and returns rows, report, stderr.
+fn scan(w: &Work, input: &str, args: &[&str]) -> (Vec<Cl>, serde_json::Value, String) {
+    let mut all = vec![input, "--mode", "scan", "-o", "cl.csv", "--report", "r.json"];
+    all.extend_from_slice(args);
+    let run = w.run(BIN, &all, b"");
+    assert!(run.status == 0 || run.status == 1, "stderr: {}", run.stderr);
+    let mut r = report(w, "r.json");
+    r["exit_status"] = run.status.into();
+    (rows(&w.read("cl.csv")), r, run.stderr)
+}
+
+/// The independent figures first, then the filter's own: exit 0 and its report agreeing.
+fn assert_covered(r: &serde_json::Value, gap: f64, below: f64) {
+    assert!(gap <= 2e-3, "a stretch of {gap} mm with the model under it is not covered");
+    assert!(below <= 2e-3, "a CL point lies {below} mm below the envelope");
+    assert_eq!(r["exit_status"], 0, "{r}");
+    assert_eq!(r["lines_not_covered"], 0, "{r}");
+    assert_eq!(r["points_below_envelope"], 0, "{r}");
+    assert!(r["largest_coverage_gap_mm"].as_f64().unwrap() <= 1e-3, "{r}");
+}
+
+#[test]
+fn s1_channel_lines_level_with_the_rim_are_traced() {
+    let w = Work::new();
+    std::fs::copy(data("stylus-trace/channel.stl"), w.path("channel.stl")).unwrap();
+    let tris = stl_corners(&data("stylus-trace/channel.stl"));
+    let (cl, r, _) = scan(&w, "channel.stl", &["-r", "3", "--pick", "5"]);
+    for y in [35.0, 45.0] {
+        let line: Vec<&Cl> = cl.iter().filter(|q| q.c.y == y).collect();
+        assert!(!line.is_empty(), "line y = {y} is missing");
+        let (lo, hi) = line.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), q| (a.min(q.c.x), b.max(q.c.x)));
+        assert!(lo <= 1e-9 && hi >= 100.0 - 1e-9, "line y = {y} runs only from x {lo} to {hi}");
+    }
+    let (gap, below) = coverage_along_x(&cl, 0.0, 100.0, &|x, y| drop_on_mesh(&tris, x, y, 3.0));
+    assert_covered(&r, gap, below);
+}
+
+#[test]
+fn s1_groove_line_has_no_gap_where_a_drop_finds_the_model() {
+    let w = Work::new();
+    std::fs::copy(data("stylus-trace/groove-strip.stl"), w.path("g.stl")).unwrap();
+    let tris = stl_corners(&data("stylus-trace/groove-strip.stl"));
+    let (cl, r, stderr) = scan(&w, "g.stl", &["-r", "3", "--pick", "1", "--region=0,50,5,5.5"]);
+    let (gap, below) = coverage_along_x(&cl, 0.0, 50.0, &|x, y| drop_on_mesh(&tris, x, y, 3.0));
+    assert_covered(&r, gap, below);
+    assert!(!stderr.contains("warning"), "{stderr}");
+}
+
+#[test]
+fn s2_rod_end_line_is_a_few_passes_on_the_envelope() {
+    let w = Work::new();
+    w.write(
+        "rod.json",
+        r#"{"surfaces": [
+ {"type": "plane", "name": "floor", "point": [0, 0, 0], "normal": [0, 0, 1]},
+ {"type": "cylinder", "name": "rod", "point": [0, 12.7, 15], "axis": [1, 0, 0], "radius": 0.5, "length": [0, 40]}]}"#,
+    );
+    let (cl, r, _) = scan(&w, "rod.json", &["-r", "12.5", "--pick", "1", "--region=10,90,0,0.5"]);
+    assert!(r["paths"].as_u64().unwrap() <= 3, "{} paths for one line", r["paths"]);
+    // The rod's lateral surface and its end circle (sampled by angle), and the floor.
+    let env = |x: f64, y: f64| {
+        let mut z: f64 = 12.5;
+        let h2 = (y - 12.7f64).powi(2);
+        if (0.0..=40.0).contains(&x) && h2 <= 13f64.powi(2) {
+            z = z.max(15.0 + (169.0 - h2).sqrt());
+        }
+        for k in 0..=20000 {
+            let t = k as f64 / 20000.0 * std::f64::consts::TAU;
+            for end in [0.0, 40.0] {
+                let p = P3::new(end, 12.7 + 0.5 * t.cos(), 15.0 + 0.5 * t.sin());
+                let d2 = (x - p.x).powi(2) + (y - p.y).powi(2);
+                if d2 <= 12.5f64.powi(2) {
+                    z = z.max(p.z + (12.5f64.powi(2) - d2).sqrt());
+                }
+            }
+        }
+        Some(z)
+    };
+    let (gap, below) = coverage_along_x(&cl, 10.0, 90.0, &env);
+    assert_covered(&r, gap, below);
+}
+
+/// The floor and a ball of radius 10 at (50, 0, 30), r = 5: the envelope closed form.
+fn floating_ball_envelope(x: f64, y: f64) -> Option<f64> {
+    let rho2 = (x - 50.0).powi(2) + y * y;
+    Some(if rho2 <= 225.0 { 30.0 + (225.0 - rho2).sqrt() } else { 5.0 })
+}
+
+#[test]
+fn s3_scan_goes_over_a_floating_ball_not_along_the_floor_under_it() {
+    let w = Work::new();
+    w.write(
+        "bf.json",
+        r#"{"surfaces": [
+ {"type": "plane", "name": "floor", "point": [0, 0, 0], "normal": [0, 0, 1]},
+ {"type": "sphere", "name": "ball", "centre": [50, 0, 30], "radius": 10}]}"#,
+    );
+    let (cl, r, _) = scan(&w, "bf.json", &["-r", "5", "--pick", "4", "--region=20,80,-16,16"]);
+    let (gap, below) = coverage_along_x(&cl, 20.0, 80.0, &floating_ball_envelope);
+    assert_covered(&r, gap, below);
+}
+
+#[test]
+fn s4_passes_end_at_the_silhouette_and_start_at_the_shadow() {
+    let w = Work::new();
+    w.write("s.json", r#"{"surfaces": [{"type": "sphere", "name": "S", "centre": [3, -2, 5], "radius": 30}]}"#);
+    let (cl, r, _) = scan(&w, "s.json", &["-r", "5", "--pick", "2"]);
+    let env = |x: f64, y: f64| {
+        let rho2 = (x - 3.0).powi(2) + (y + 2.0).powi(2);
+        (rho2 <= 35f64.powi(2)).then(|| 5.0 + (35f64.powi(2) - rho2).sqrt())
+    };
+    let (gap, below) = coverage_along_x(&cl, -27.0, 33.0, &env);
+    assert_covered(&r, gap, below);
+}
+
+#[test]
+fn coverage_is_measured_on_the_rounded_output() {
+    // Rounded to 3 decimals, the 0.5 µm hop between passes at the ball's silhouettes is written
+    // as 1 µm: within the gap tolerance widened by the rounding unit, and measured as written.
+    let w = Work::new();
+    w.write(
+        "bf.json",
+        r#"{"surfaces": [
+ {"type": "plane", "name": "floor", "point": [0, 0, 0], "normal": [0, 0, 1]},
+ {"type": "sphere", "name": "ball", "centre": [50, 0, 30], "radius": 10}]}"#,
+    );
+    let (cl, r, stderr) = scan(&w, "bf.json", &["-r", "5", "--pick", "4", "--region=20,80,-16,16", "--decimals", "3"]);
+    assert_eq!(r["exit_status"], 0, "{stderr}");
+    assert!((r["coverage_gap_tol_mm"].as_f64().unwrap() - 0.002).abs() < 1e-12, "{r}");
+    let gap = r["largest_coverage_gap_mm"].as_f64().unwrap();
+    assert!(gap > 0.0 && gap <= 0.002, "{r}");
+    let (gap_measured, below) = coverage_along_x(&cl, 20.0, 80.0, &floating_ball_envelope);
+    assert!(gap_measured <= 0.002 && below <= 2e-3, "{gap_measured} {below}");
+}

@@ -36,7 +36,7 @@ pub fn trace_level(
     let mut out = Vec::new();
     for (pts, deviation) in loops {
         for run in front_runs(&pts) {
-            out.push(TracedPath { points: run, deviation, interrupted: false });
+            out.push(TracedPath { points: run, deviation, interrupted: false, unit: 0 });
         }
     }
     Ok(out)

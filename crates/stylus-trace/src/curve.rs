@@ -90,7 +90,7 @@ pub struct Stylus {
 
 impl Stylus {
     /// |ΔR| the corrections aim for: well inside the tolerance, since Newton converges fast.
-    fn target(&self) -> f64 {
+    pub fn target(&self) -> f64 {
         (self.contact_tol * 1e-3).max(1e-12 * self.radius)
     }
 }
@@ -106,18 +106,24 @@ pub struct PlaneCurve<'a> {
     pub plane_normal: V3,
     /// Where the offset surface is nearly parallel to the motion plane (|g| below [`MIN_SLOPE`]),
     /// correct anyway along g, each move at most this long (mm), instead of giving up. Contour
-    /// levels near a flat spot need it; scan lines give up there (the stylus slides off a
-    /// sheet's side) and use `None`. The chord check of every step catches a move that lands on
-    /// another branch of the curve.
+    /// levels near a flat spot need it; scan lines give up there (the motion plane is nearly
+    /// tangent to the offset surface: they go on by drops) and use `None`. The chord check of
+    /// every step catches a move that lands on another branch of the curve.
     pub flat_moves: Option<f64>,
 }
 
 impl PlaneCurve<'_> {
-    /// The curve point at a converged centre.
-    fn finish(&self, c: P3, n: &Nearest, iterations: u32) -> Option<CurvePoint> {
+    /// The curve point at a converged centre. Where L stands square to the motion plane (a
+    /// scan line right over a contact on a wall parallel to it) the curve runs level: the tangent
+    /// is the plane's horizontal direction then.
+    pub fn finish(&self, c: P3, n: &Nearest, iterations: u32) -> Option<CurvePoint> {
         let u = n.direction(&c);
         let g = u - self.plane_normal * u.dot(&self.plane_normal);
-        let tangent = self.plane_normal.cross(&g).try_normalize(1e-9)?;
+        let tangent = self
+            .plane_normal
+            .cross(&g)
+            .try_normalize(1e-9)
+            .or_else(|| self.plane_normal.cross(&V3::z()).try_normalize(1e-9))?;
         let cl = ClPoint {
             centre: c,
             contact: n.point,
@@ -283,7 +289,7 @@ pub struct Steps {
 
 /// Fraction of the chord tolerance a step aims for (the estimate below can miss a corner's
 /// deviation by up to a quarter).
-const AIM: f64 = 0.7;
+pub const AIM: f64 = 0.7;
 
 /// An accepted step.
 #[derive(Clone, Copy, Debug)]

@@ -7,10 +7,13 @@
 //!
 //! Modes: scanning lines ([`scan`]), contour lines ([`contour`]) and two-surface contact
 //! ([`two_surface`]); the tracer they share is in [`curve`]; [`output`] makes the toolpath table
-//! and the plot; [`verify`] re-measures every CL point against the whole model.
+//! and the plot; [`verify`] re-measures every CL point against the whole model, and in scan mode
+//! [`coverage`] compares every line with an independent drop of the stylus ([`envelope`]).
 
 pub mod contour;
+pub mod coverage;
 pub mod curve;
+pub mod envelope;
 pub mod output;
 pub mod scan;
 pub mod two_surface;
@@ -56,9 +59,11 @@ pub struct TracedPath {
     pub points: Vec<ClPoint>,
     /// Largest estimated chord deviation of its steps (mm).
     pub deviation: f64,
-    /// True when the pass ended because the stylus could not follow the model any further
-    /// (scan mode: it slid off the side of a sheet); the next pass starts beyond.
+    /// True when the pass ended because the stylus could not follow the model any further (scan
+    /// mode: neither copying nor drops go on, the envelope jumps); the next pass starts beyond.
     pub interrupted: bool,
+    /// The unit of work it belongs to (scan line, contour level; 0 in two-surface mode).
+    pub unit: usize,
 }
 
 /// What to trace.
@@ -115,16 +120,21 @@ pub fn trace(model: &Model, opts: &Options, tick: &(dyn Fn() + Sync)) -> Result<
     let nested: Vec<Vec<TracedPath>> = match &opts.mode {
         Mode::Scan(s) => scan::lines(s)
             .par_iter()
-            .map(|line| {
-                let r = scan::trace_line(model, stylus, steps, line);
+            .enumerate()
+            .map(|(k, line)| {
+                let r = scan::trace_line(model, stylus, steps, line, k);
                 tick();
                 r
             })
             .collect::<Result<_, _>>()?,
         Mode::Contour { region, levels } => levels
             .par_iter()
-            .map(|&z| {
-                let r = contour::trace_level(model, stylus, steps, region, z);
+            .enumerate()
+            .map(|(k, &z)| {
+                let r = contour::trace_level(model, stylus, steps, region, z).map(|mut v| {
+                    v.iter_mut().for_each(|p| p.unit = k);
+                    v
+                });
                 tick();
                 r
             })

@@ -5,11 +5,13 @@ use camkit::error::{Error, Location, Result};
 use camkit::geom::P3;
 use camkit::io::{Input, Output, write_atomic};
 use camkit::model::Model;
+use camkit::num::round_to;
 use camkit::report::Report;
 use camkit::table::{self, Col, WriteOptions};
 use clap::{Parser, ValueEnum};
 use std::path::PathBuf;
 use std::time::Instant;
+use stylus_trace::coverage::{self, Coverage, Tolerances};
 use stylus_trace::curve::{Steps, Stylus};
 use stylus_trace::scan::Scan;
 use stylus_trace::two_surface::TwoSurface;
@@ -107,7 +109,12 @@ fn after_help() -> String {
     s.push_str("  surface                   name of the model surface touched\n");
     s.push_str("two-surface mode adds p2x,p2y,p2z n2x,n2y,n2z surface2 (second contact) and bx,by,bz (bisector).\n");
     s.push_str("x,y,z is the stylus centre; nx,ny,nz is L/|L|, from the contact towards the centre.\n");
-    s.push_str("\nExit status: 0 done, 1 a check failed (no convergence, |ΔR| over tolerance), 2 bad input or usage.");
+    s.push_str(
+        "\nScan mode checks every line against an independent drop of the stylus: a stretch with the model under it\n\
+         that no pass covers (longer than --chord-tol) or a CL point below the stylus's upper envelope (deeper than\n\
+         --contact-tol plus the rounding) is named on stderr; the output is written and the exit status is 1.\n",
+    );
+    s.push_str("\nExit status: 0 done, 1 a check failed (no convergence, |ΔR| over tolerance, coverage), 2 bad input or usage.");
     s
 }
 
@@ -276,10 +283,14 @@ fn run(args: Args) -> Result<()> {
     let verified = stylus_trace::verify(&model, &opts.stylus, &paths, two).map_err(|rej| {
         Error::check(format!("CL point in row {} (line {} of the output): {}", rej.row + 1, rej.row + 2, rej.what))
     })?;
+    let coverage = match &opts.mode {
+        Mode::Scan(scan) => Some(check_coverage(&model, &opts, scan, &paths, args.decimals)),
+        _ => None,
+    };
     let interrupted = paths.iter().filter(|p| p.interrupted).count();
     if interrupted > 0 {
         cli::warn(&format!(
-            "{interrupted} passes end where the stylus could not follow the model (off the side of a sheet); the next pass starts beyond"
+            "{interrupted} passes end where neither copying nor drops could follow the envelope (a jump); the next pass starts --chord-tol/2 on"
         ));
     }
     let tag = opts.mode.tag();
@@ -324,7 +335,80 @@ fn run(args: Args) -> Result<()> {
             .set("seconds", seconds)
             .set("points_per_second", verified.points as f64 / trace_seconds.max(1e-9))
             .set("threads", rayon::current_num_threads());
+        if let Some((c, tol)) = &coverage {
+            r.set("coverage_lines", c.lines)
+                .set("coverage_drops", c.drops)
+                .set("coverage_gap_tol_mm", tol.gap)
+                .set("largest_coverage_gap_mm", c.largest_gap)
+                .set("envelope_tol_mm", tol.below)
+                .set("points_below_envelope", c.points_below)
+                .set("largest_below_envelope_mm", c.largest_below)
+                .set("chord_tol_below_envelope_mm", tol.chord)
+                .set("chord_samples", c.chord_samples)
+                .set("chord_samples_below_envelope", c.chords_below)
+                .set("largest_chord_below_envelope_mm", c.largest_chord_below)
+                .set("lines_not_covered", lines_failing(c));
+        }
         r.write(path)?;
     }
-    out.commit()
+    out.commit()?;
+    match &coverage {
+        Some((c, _)) if !c.defects.is_empty() => Err(Error::check(format!(
+            "{} of {} scan lines fail the coverage check (largest gap {:.4} mm, {} points below the envelope by up to {:.4} mm, chords at {} positions by up to {:.4} mm)",
+            lines_failing(c),
+            c.lines,
+            c.largest_gap,
+            c.points_below,
+            c.largest_below,
+            c.chords_below,
+            c.largest_chord_below
+        ))),
+        _ => Ok(()),
+    }
+}
+
+/// Number of scan lines with a defect.
+fn lines_failing(c: &Coverage) -> usize {
+    let mut lines: Vec<usize> = c.defects.iter().map(|d| d.line).collect();
+    lines.dedup();
+    lines.len()
+}
+
+/// Most defects named one by one on stderr.
+const SHOWN_DEFECTS: usize = 20;
+
+/// The coverage check of scan mode on what is written (positions rounded to `decimals`); every
+/// failing stretch is warned about with its line and range.
+fn check_coverage(
+    model: &Model,
+    opts: &Options,
+    scan: &Scan,
+    paths: &[stylus_trace::TracedPath],
+    decimals: Option<u32>,
+) -> (Coverage, Tolerances) {
+    let unit = decimals.map_or(0.0, |d| 10f64.powi(-(d as i32)));
+    let tol = Tolerances {
+        // Rounding moves each end of a hole by up to half a unit.
+        gap: opts.steps.chord_tol + unit,
+        below: opts.stylus.contact_tol + unit,
+        chord: opts.steps.chord_tol + opts.stylus.contact_tol + unit,
+        spacing: stylus_trace::scan::sample_spacing(&opts.stylus, &opts.steps),
+    };
+    let round = |v: f64| decimals.map_or(v, |d| round_to(v, d));
+    let c = coverage::check(model, opts.stylus.radius, scan, paths, &tol, &round);
+    for d in c.defects.iter().take(SHOWN_DEFECTS) {
+        cli::warn(&format!(
+            "scan line {} from ({}, {}) to ({}, {}): {}",
+            d.line + 1,
+            round_to(d.from.x, 3),
+            round_to(d.from.y, 3),
+            round_to(d.to.x, 3),
+            round_to(d.to.y, 3),
+            d.what
+        ));
+    }
+    if c.defects.len() > SHOWN_DEFECTS {
+        cli::warn(&format!("{} more stretches fail the coverage check", c.defects.len() - SHOWN_DEFECTS));
+    }
+    (c, tol)
 }

@@ -1,9 +1,13 @@
 //! Scanning-line mode: motion planes stand vertical along the scan direction, one per pick feed;
 //! on each the stylus is dropped from above onto the model and then copies it to the end of the
-//! region. Where the model falls away under the stylus (an overhang, the edge of a sheet) the pass
-//! ends and the stylus is dropped again beyond it.
+//! region. The CL of a line is the stylus's upper envelope over the model: a pass goes on only
+//! while its points are on it (touching from above, moving on, nothing of the model over them),
+//! so it ends at a silhouette (the model falls away: an overhang, the edge of a sheet) or under
+//! something higher, at the point found by bisection, and the stylus is dropped again just beyond.
+//! Where copying cannot go on (the motion plane nearly tangent to the offset surface) the pass
+//! goes on by drops while their chords stay within the chord tolerance.
 
-use crate::curve::{Curve, CurvePoint, PlaneCurve, Steps, Stylus, step};
+use crate::curve::{AIM, Curve, CurvePoint, PlaneCurve, Steps, Stylus, step};
 use crate::{Failure, Region, TracedPath};
 use camkit::geom::{P3, V3};
 use camkit::model::Model;
@@ -35,11 +39,13 @@ pub struct Line {
 }
 
 impl Line {
-    fn at(&self, s: f64, z: f64) -> P3 {
+    /// The point at parameter `s`, height `z`.
+    pub fn at(&self, s: f64, z: f64) -> P3 {
         P3::new(self.origin.x + self.dir.x * s, self.origin.y + self.dir.y * s, z)
     }
 
-    fn s_of(&self, p: &P3) -> f64 {
+    /// The parameter of `p`'s foot on the line.
+    pub fn s_of(&self, p: &P3) -> f64 {
         (p - self.origin).dot(&self.dir)
     }
 }
@@ -81,9 +87,37 @@ pub fn lines(scan: &Scan) -> Vec<Line> {
     out
 }
 
-/// Traces one scan line; the passes it yields, in order. A pass ends at the region's end, where
-/// the model falls away (an overhang), or where the stylus cannot follow it (`interrupted`).
-pub fn trace_line(model: &Model, stylus: Stylus, steps: &Steps, line: &Line) -> Result<Vec<TracedPath>, Failure> {
+/// What a line's tracer needs besides the line: the curve, the column heights and the steps.
+struct Tracer<'a> {
+    curve: PlaneCurve<'a>,
+    line: &'a Line,
+    steps: &'a Steps,
+    /// Where drops start.
+    z_top: f64,
+    /// Where a drop gives up.
+    z_bottom: f64,
+    /// How far past a pass's end the stylus is dropped again (below the coverage check's gap
+    /// tolerance, the chord tolerance).
+    hop: f64,
+    /// Spacing of the sample positions along the line where chords are checked.
+    spacing: f64,
+}
+
+/// Spacing of the positions along a scan line where the chords between CL points are checked
+/// against the envelope, by the tracer and by the coverage check alike: min(longest step, r/4).
+pub fn sample_spacing(stylus: &Stylus, steps: &Steps) -> f64 {
+    steps.max_step.min(0.25 * stylus.radius)
+}
+
+/// Traces line number `unit`; the passes it yields, in order. A pass ends at the region's end,
+/// at a silhouette, under a higher part of the model, or where the envelope jumps.
+pub fn trace_line(
+    model: &Model,
+    stylus: Stylus,
+    steps: &Steps,
+    line: &Line,
+    unit: usize,
+) -> Result<Vec<TracedPath>, Failure> {
     let curve = PlaneCurve { model, stylus, plane_normal: V3::z().cross(&line.dir), flat_moves: None };
     let bounds = model.bounds();
     let (z_top, z_bottom) = if bounds.is_bounded() {
@@ -91,15 +125,194 @@ pub fn trace_line(model: &Model, stylus: Stylus, steps: &Steps, line: &Line) -> 
     } else {
         (1e4, -1e4)
     };
-    // Where nothing is under the stylus, look again this far on.
-    let probe = steps.max_step.min(stylus.radius * 0.5);
+    let hop = (steps.chord_tol * 0.5).max(steps.min_step);
+    let t = Tracer { curve, line, steps, z_top, z_bottom, hop, spacing: sample_spacing(&stylus, steps) };
     let mut paths = Vec::new();
     let mut s = line.s0;
+    let mut missed: Option<f64> = None;
     while s <= line.s1 {
-        let Some(start) = drop(&curve, line, s, z_top, z_bottom) else {
-            s = if s < line.s1 { (s + probe).min(line.s1) } else { f64::INFINITY };
-            continue;
+        let mut start = match t.land_or_clear(s) {
+            Ok(p) => p,
+            Err(clear) => {
+                // Nothing is under the stylus, nor within `clear` of it: look again that far
+                // on (a shadow shorter than the hop may be passed over).
+                missed = Some(s);
+                s = if s < line.s1 { (s + clear.max(t.hop)).min(line.s1) } else { f64::INFINITY };
+                continue;
+            }
         };
+        // After a miss, the model's shadow begins somewhere before s: find it.
+        if let Some(mut m) = missed.take() {
+            let mut hit = s;
+            while hit - m > 0.5 * t.hop {
+                let mid = 0.5 * (m + hit);
+                match t.land(mid) {
+                    Some(p) => {
+                        hit = mid;
+                        start = p;
+                    }
+                    None => m = mid,
+                }
+            }
+        }
+        let (pass, ended_at) = t.follow(start);
+        paths.push(TracedPath { unit, ..pass });
+        // Always onwards: a drop's correction may have landed behind where it was dropped.
+        s = if ended_at >= line.s1 { f64::INFINITY } else { ended_at.max(s) + t.hop };
+    }
+    Ok(paths)
+}
+
+impl Tracer<'_> {
+    fn s_of(&self, p: &CurvePoint) -> f64 {
+        self.line.s_of(&p.cl.centre)
+    }
+
+    /// True when `b`, reached from `a`, is on the upper envelope: it touches from above or from
+    /// the side (the tangent does not turn back), it does not go back along the line, and no
+    /// part of the model lies over it: a drop from the top meets nothing above it where its
+    /// contact faces up, and lands on it (across the envelope, within ten contact tolerances)
+    /// where the face is steep. A pass climbing a vertical wall (a step of the envelope) goes on.
+    fn on_envelope(&self, a: &CurvePoint, b: &CurvePoint) -> bool {
+        let back = 1e-9;
+        if b.tangent.dot(&self.line.dir) < -back || self.s_of(b) < self.s_of(a) - back {
+            return false;
+        }
+        let (up, c, tol) = (b.cl.normal.z, b.cl.centre, 10.0 * self.curve.stylus.contact_tol);
+        if up <= 1e-6 {
+            return true;
+        }
+        if up >= 0.05 {
+            return !matches!(self.descend(c.x, c.y, c.z + tol / up), Descent::Contact { .. });
+        }
+        match self.land_or_clear(self.s_of(b)) {
+            Ok(top) => (top.cl.centre.z - c.z) * top.cl.normal.z.abs() <= tol,
+            Err(_) => true,
+        }
+    }
+
+    /// True when the chord from `a` to `b` runs nowhere below the envelope by more than the chord
+    /// tolerance (across it: the vertical depth times the z of its normal) at the sample positions
+    /// inside it: a part of the model narrower than a step, which copying steps over, ends the
+    /// pass before it.
+    fn chord_clear(&self, a: &CurvePoint, b: &CurvePoint) -> bool {
+        let (sa, sb) = (self.s_of(a), self.s_of(b));
+        let (s0, w) = (self.line.s0, self.spacing);
+        let mut j = ((sa - s0) / w).floor() as i64 + 1;
+        loop {
+            let s = s0 + j as f64 * w;
+            j += 1;
+            if s >= sb {
+                return true;
+            }
+            if s <= sa {
+                continue;
+            }
+            let c = a.cl.centre + (b.cl.centre - a.cl.centre) * ((s - sa) / (sb - sa));
+            if let Descent::Contact { below, above } = self.descend(c.x, c.y, c.z) {
+                match self.settle(s, below, above) {
+                    Some(top) if (top.cl.centre.z - c.z) * top.cl.normal.z.abs() <= self.steps.chord_tol => {}
+                    _ => return false,
+                }
+            }
+        }
+    }
+
+    /// The stylus dropped at `s` onto its highest contact, or `None` if nothing is under it.
+    fn land(&self, s: f64) -> Option<CurvePoint> {
+        self.land_or_clear(s).ok()
+    }
+
+    /// The stylus dropped at `s` onto its highest contact, or how far it is clear of the model
+    /// (a lower bound of |L| − r down the whole column; 0 if it touched but did not settle).
+    fn land_or_clear(&self, s: f64) -> Result<CurvePoint, f64> {
+        let p = self.line.at(s, 0.0);
+        match self.descend(p.x, p.y, self.z_bottom) {
+            Descent::Contact { below, above } => self.settle(s, below, above).ok_or(0.0),
+            Descent::Clear { margin } => Err(margin),
+        }
+    }
+
+    /// Sphere tracing down the vertical through (x, y) from the top to `z_stop`: steps of
+    /// |L| − r never pass a contact, |L| being 1-Lipschitz; near a face that faces up the step
+    /// is the vertical Newton step (|L| − r)/L̂_z, and it is never shorter than a length that can
+    /// pass a contact only by a depth of step²/8r, the contact tolerance (beside a vertical wall
+    /// |L| − r stays small without a contact below).
+    fn descend(&self, x: f64, y: f64, z_stop: f64) -> Descent {
+        let (r, tol) = (self.curve.stylus.radius, self.curve.stylus.contact_tol);
+        let least = (8.0 * r * tol).sqrt();
+        let gap_at = |z: f64| {
+            let c = P3::new(x, y, z);
+            let n = self.curve.model.nearest(&c);
+            (n.distance - r, n.direction(&c).z)
+        };
+        let mut z = self.z_top;
+        let mut above: Option<(f64, f64)> = None;
+        // A lower bound of |L| − r over the column searched so far: between heights a step h
+        // apart with gaps g₀, g₁ it is at least (g₀ + g₁ − h)/2, |L| being 1-Lipschitz.
+        let mut margin = f64::INFINITY;
+        for _ in 0..100_000 {
+            let (gap, up) = gap_at(z.max(z_stop));
+            if let Some((za, ga)) = above {
+                margin = margin.min(0.5 * (ga + gap - (za - z.max(z_stop))));
+            }
+            if z <= z_stop {
+                return Descent::Clear { margin: margin.max(0.0) };
+            }
+            // Newton from above a face that bulges up stays above the contact: close enough is
+            // a contact too.
+            if gap <= self.curve.stylus.target() {
+                return Descent::Contact { below: z, above };
+            }
+            above = Some((z, gap));
+            z -= if up > 0.2 { (gap / up).min(gap + least) } else { gap.max(least) };
+        }
+        Descent::Clear { margin: 0.0 }
+    }
+
+    /// The contact between a height inside (|L| < r at `below`) and one outside (`above`, with
+    /// its |L| − r), by regula falsi (Illinois) on |L| − r down to the correction target.
+    fn settle(&self, s: f64, below: f64, above: Option<(f64, f64)>) -> Option<CurvePoint> {
+        let stylus = self.curve.stylus;
+        let target = stylus.target();
+        let at = |z: f64| {
+            let c = self.line.at(s, z);
+            let n = self.curve.model.nearest(&c);
+            (c, n, n.distance - stylus.radius)
+        };
+        let (c, n, gap) = at(below);
+        if gap.abs() <= target || above.is_none() {
+            return if n.converged && gap.abs() <= stylus.contact_tol { self.curve.finish(c, &n, 1) } else { None };
+        }
+        let ((mut z0, mut f0), (mut z1, mut f1)) = ((below, gap), above.expect("checked above"));
+        let mut side = 0;
+        for it in 1..=200 {
+            let z = if f1 - f0 != 0.0 { z0 - f0 * (z1 - z0) / (f1 - f0) } else { 0.5 * (z0 + z1) };
+            let z = if z > z0.min(z1) && z < z0.max(z1) { z } else { 0.5 * (z0 + z1) };
+            let (c, n, f) = at(z);
+            if f.abs() <= target || (z1 - z0).abs() < 1e-13 * (1.0 + z.abs()) {
+                return (n.converged && f.abs() <= stylus.contact_tol).then(|| self.curve.finish(c, &n, it)).flatten();
+            }
+            if f < 0.0 {
+                (z0, f0) = (z, f);
+                if side == -1 {
+                    f1 *= 0.5;
+                }
+                side = -1;
+            } else {
+                (z1, f1) = (z, f);
+                if side == 1 {
+                    f0 *= 0.5;
+                }
+                side = 1;
+            }
+        }
+        None
+    }
+
+    /// One pass from `start` along the envelope; the pass and the parameter where it ends.
+    fn follow(&self, start: CurvePoint) -> (TracedPath, f64) {
+        let (line, steps) = (self.line, self.steps);
         let mut pts = vec![start];
         let mut h = steps.max_step * 0.25;
         let mut deviation: f64 = 0.0;
@@ -107,66 +320,104 @@ pub fn trace_line(model: &Model, stylus: Stylus, steps: &Steps, line: &Line) -> 
         let mut interrupted = false;
         loop {
             let a = *pts.last().expect("a pass has a start");
-            let sa = line.s_of(&a.cl.centre);
+            let sa = self.s_of(&a);
             if sa >= line.s1 - camkit::tol::POINT_EPS {
                 break;
             }
-            // Overhang: the curve turns back under the model; this pass ends here.
-            if a.tangent.dot(&line.dir) < -1e-6 {
-                ended_at = sa;
-                break;
-            }
-            let Some(st) = step(&curve, &a, h, steps) else {
-                // The stylus loses the model (it slides off a sheet's side): the pass ends here
-                // and the stylus is dropped again farther on.
-                ended_at = sa;
-                interrupted = true;
-                break;
-            };
-            let mut next = st.to;
-            if line.s_of(&next.cl.centre) > line.s1 {
-                // The last point lies on the region's end: drop onto the curve there.
-                let t = (line.s1 - sa) / (line.s_of(&next.cl.centre) - sa);
-                let guess = a.cl.centre + (next.cl.centre - a.cl.centre) * t;
-                match curve.correct(&P3::new(guess.x, guess.y, guess.z.max(next.cl.centre.z)), &line.dir) {
-                    Some(end) => next = end,
-                    None => {
-                        next = st.to;
+            let (mut next, dev, next_h) = match step(&self.curve, &a, h, steps) {
+                Some(st) if self.on_envelope(&a, &st.to) && self.chord_clear(&a, &st.to) => {
+                    (st.to, st.deviation, st.next)
+                }
+                Some(st) => {
+                    // It left the envelope within this step: end the pass where it does.
+                    if let Some(b) = self.boundary(&a, (st.to.cl.centre - a.cl.centre).norm()) {
+                        pts.push(b);
                     }
+                    ended_at = self.s_of(pts.last().expect("a pass has a start"));
+                    break;
+                }
+                None => match self.drop_step(&a, h) {
+                    Some(found) => found,
+                    None => {
+                        // Neither copying nor drops go on: the envelope jumps here.
+                        ended_at = sa;
+                        interrupted = true;
+                        break;
+                    }
+                },
+            };
+            if self.s_of(&next) > line.s1 {
+                // The last point lies on the region's end: drop onto the curve there.
+                let t = (line.s1 - sa) / (self.s_of(&next) - sa);
+                let guess = a.cl.centre + (next.cl.centre - a.cl.centre) * t;
+                if let Some(end) = self
+                    .curve
+                    .correct(&P3::new(guess.x, guess.y, guess.z.max(next.cl.centre.z)), &line.dir)
+                    .or_else(|| self.land(line.s1))
+                {
+                    next = end;
                 }
             }
-            deviation = deviation.max(st.deviation);
-            h = st.next;
+            deviation = deviation.max(dev);
+            h = next_h;
             pts.push(next);
         }
-        paths.push(TracedPath { points: pts.into_iter().map(|p| p.cl).collect(), deviation, interrupted });
-        // Always onwards: a drop's correction may have landed behind where it was dropped.
-        s = if ended_at >= line.s1 { f64::INFINITY } else { ended_at.max(s) + steps.min_step.max(1e-3) };
+        let pass = TracedPath { points: pts.into_iter().map(|p| p.cl).collect(), deviation, interrupted, unit: 0 };
+        (pass, ended_at)
     }
-    Ok(paths)
+
+    /// The farthest point on the envelope from `a` along its tangent, the step of length `bad`
+    /// having left it: bisection on the step length down to the shortest step.
+    fn boundary(&self, a: &CurvePoint, bad: f64) -> Option<CurvePoint> {
+        let (mut lo, mut hi, mut best) = (0.0, bad, None);
+        while hi - lo > self.steps.min_step {
+            let mid = 0.5 * (lo + hi);
+            let p = self.curve.correct(&(a.cl.centre + a.tangent * mid), &a.tangent).filter(|p| {
+                (p.cl.centre - a.cl.centre).dot(&a.tangent) > 0.0 && self.on_envelope(a, p) && self.chord_clear(a, p)
+            });
+            match p {
+                Some(p) => {
+                    lo = mid;
+                    best = Some(p);
+                }
+                None => hi = mid,
+            }
+        }
+        best
+    }
+
+    /// A step by drops where copying cannot go on: the stylus dropped `h` on (shortened down to
+    /// the shortest step) is taken when the drop halfway lies within the chord tolerance of the
+    /// chord. The new point, its chord deviation and the next step length.
+    fn drop_step(&self, a: &CurvePoint, h: f64) -> Option<(CurvePoint, f64, f64)> {
+        let (steps, sa) = (self.steps, self.s_of(a));
+        let mut h = h.clamp(steps.min_step, steps.max_step);
+        loop {
+            let sb = (sa + h).min(self.line.s1);
+            if let (Some(b), Some(m)) = (self.land(sb), self.land(0.5 * (sa + sb))) {
+                let mid = a.cl.centre + (b.cl.centre - a.cl.centre) * 0.5;
+                let dev = (m.cl.centre.z - mid.z).abs();
+                if dev <= steps.chord_tol * AIM && self.s_of(&b) > sa && self.chord_clear(a, &b) {
+                    return Some((b, dev, (2.0 * h).min(steps.max_step)));
+                }
+            }
+            if h <= steps.min_step {
+                return None;
+            }
+            h = (h * 0.5).max(steps.min_step);
+        }
+    }
 }
 
-/// The stylus dropped from `z_top` at `s` onto the first contact, or `None` if it falls past
-/// `z_bottom`. Sphere tracing (steps of |L| − r never pass through the model, |L| being
-/// 1-Lipschitz) brings it close; a vertical Newton correction lands it.
-fn drop(curve: &PlaneCurve, line: &Line, s: f64, z_top: f64, z_bottom: f64) -> Option<CurvePoint> {
-    let r = curve.stylus.radius;
-    // Beside a vertical wall |L| − r stays small without a contact below; a step this long can
-    // pass a contact only by a depth of step²/8r, the contact tolerance.
-    let least = (8.0 * r * curve.stylus.contact_tol).sqrt();
-    let mut z = z_top;
-    for _ in 0..100_000 {
-        let c = line.at(s, z);
-        let n = curve.model.nearest(&c);
-        let gap = n.distance - r;
-        if gap <= 0.05 * r && n.direction(&c).z.abs() >= 0.2 {
-            let p = curve.correct(&c, &line.dir)?;
-            return (p.cl.centre.z >= z_bottom).then_some(p);
-        }
-        z -= gap.max(least);
-        if z < z_bottom {
-            return None;
-        }
-    }
-    None
+/// The end of a drop.
+enum Descent {
+    /// The stylus met the model: a height inside it (or within the target of touching) and the
+    /// last one outside with its |L| − r.
+    Contact { below: f64, above: Option<(f64, f64)> },
+    /// It went down to the stop without touching; |L| − r was at least `margin` all the way,
+    /// so no column within that distance horizontally touches either.
+    Clear {
+        /// Lower bound of |L| − r along the column.
+        margin: f64,
+    },
 }

@@ -55,6 +55,7 @@ pub fn trace(model: &Model, stylus: Stylus, steps: &Steps, ts: &TwoSurface) -> R
             points: forward.iter().map(|p| p.cl).collect(),
             deviation: dev_f,
             interrupted: false,
+            unit: 0,
         }]);
     }
     // An open line: trace back from the seed the other way and join.
@@ -66,7 +67,7 @@ pub fn trace(model: &Model, stylus: Stylus, steps: &Steps, ts: &TwoSurface) -> R
     let (backward, _, dev_b) = follow(&back_curve, back_seed, steps, &ts.region, r);
     let mut pts: Vec<_> = backward.iter().rev().map(|p| p.cl).collect();
     pts.extend(forward.iter().skip(1).map(|p| p.cl));
-    Ok(vec![TracedPath { points: pts, deviation: dev_f.max(dev_b), interrupted: false }])
+    Ok(vec![TracedPath { points: pts, deviation: dev_f.max(dev_b), interrupted: false, unit: 0 }])
 }
 
 /// Steps from `seed` until the line closes, leaves the region, or the double contact is lost.

@@ -2,12 +2,15 @@
 //! cylinders and NURBS cylinders, random stylus radii and scan directions, every CL point lies at
 //! distance r from the surface within the contact tolerance (by the surface's own formula, not
 //! the model's query), every chord stays within the chord tolerance of the true CL curve (sampled
-//! densely), one-way and zig-zag scans give the same points, and contour levels close.
+//! densely), one-way and zig-zag scans give the same points, and contour levels close. Random
+//! closed meshes and analytic composites: every scan line is the stylus's upper envelope as an
+//! independent drop gives it.
 
 use camkit::geom::{P3, V3};
 use camkit::io::Input;
 use camkit::model::Model;
 use proptest::prelude::*;
+use stylus_trace::coverage::{self, Tolerances};
 use stylus_trace::curve::{Steps, Stylus};
 use stylus_trace::scan::Scan;
 use stylus_trace::two_surface::TwoSurface;
@@ -219,5 +222,100 @@ proptest! {
             (v - n * v.dot(&n)).norm() - rho
         });
         prop_assert!(chords <= CHORD, "chord off by {}", chords);
+    }
+}
+
+/// Every scan line against the independent drop ([`stylus_trace::envelope`]): no stretch with
+/// the model under it left uncovered beyond the chord tolerance, no CL point below the envelope.
+fn assert_lines_cover(m: &Model, opts: &Options) -> Result<(), TestCaseError> {
+    let Mode::Scan(s) = &opts.mode else { unreachable!("a scan") };
+    let paths = trace(m, opts, &|| ()).map_err(|f| TestCaseError::fail(format!("{f:?}")))?;
+    let tol = Tolerances {
+        gap: CHORD,
+        below: CONTACT,
+        chord: CHORD + CONTACT,
+        spacing: stylus_trace::scan::sample_spacing(&opts.stylus, &opts.steps),
+    };
+    let c = coverage::check(m, opts.stylus.radius, s, &paths, &tol, &|v| v);
+    prop_assert!(c.defects.is_empty(), "{:?}", &c.defects[..c.defects.len().min(3)]);
+    prop_assert!(c.largest_gap <= CHORD && c.points_below == 0 && c.chords_below == 0, "{:?}", c);
+    Ok(())
+}
+
+/// A closed block whose top is a random height field on a coarse grid over [0, 40]², sides and
+/// bottom flat, and a closed box floating over part of it.
+fn block_and_box(heights: &[f64], n: usize, boxed: [f64; 4]) -> Vec<[P3; 3]> {
+    let step = 40.0 / n as f64;
+    let top = |i: usize, j: usize| P3::new(i as f64 * step, j as f64 * step, heights[j * (n + 1) + i]);
+    let bot = |i: usize, j: usize| P3::new(i as f64 * step, j as f64 * step, -5.0);
+    let mut t = Vec::new();
+    let mut quad = |a: P3, b: P3, c: P3, d: P3| {
+        t.push([a, b, c]);
+        t.push([a, c, d]);
+    };
+    for i in 0..n {
+        for j in 0..n {
+            quad(top(i, j), top(i + 1, j), top(i + 1, j + 1), top(i, j + 1));
+            quad(bot(i, j), bot(i, j + 1), bot(i + 1, j + 1), bot(i + 1, j));
+        }
+        quad(bot(i, 0), bot(i + 1, 0), top(i + 1, 0), top(i, 0));
+        quad(bot(i + 1, n), bot(i, n), top(i, n), top(i + 1, n));
+        quad(bot(0, i + 1), bot(0, i), top(0, i), top(0, i + 1));
+        quad(bot(n, i), bot(n, i + 1), top(n, i + 1), top(n, i));
+    }
+    let [x, y, z, s] = boxed;
+    let p = |a: f64, b: f64, c: f64| P3::new(x + a * s, y + b * s * 0.6, z + c * 3.0);
+    let v = [
+        p(0., 0., 0.),
+        p(1., 0., 0.),
+        p(1., 1., 0.),
+        p(0., 1., 0.),
+        p(0., 0., 1.),
+        p(1., 0., 1.),
+        p(1., 1., 1.),
+        p(0., 1., 1.),
+    ];
+    for [a, b, c, d] in [[0, 3, 2, 1], [4, 5, 6, 7], [0, 1, 5, 4], [1, 2, 6, 5], [2, 3, 7, 6], [3, 0, 4, 7]] {
+        quad(v[a], v[b], v[c], v[d]);
+    }
+    t
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 24, ..ProptestConfig::default() })]
+
+    /// Random closed meshes (a height-field block and a box floating over it, so lines meet
+    /// steps, overhangs and jumps of the envelope): every scan line is the envelope.
+    #[test]
+    fn mesh_scan_lines_are_the_envelope(
+        heights in proptest::collection::vec(0.0..8.0f64, 36),
+        bx in 0.0..30.0f64, by in 0.0..30.0f64, bz in 6.0..20.0f64, bs in 4.0..14.0f64,
+        r in 0.8..5.0f64, angle in 0.0..180.0f64, pick in 2.5..6.0f64,
+    ) {
+        let tris = block_and_box(&heights, 5, [bx, by, bz, bs]);
+        let m = Model::load(&Input { name: "m.stl".into(), data: camkit::model::mesh::binary_stl(&tris) }).unwrap();
+        let region = Region { x0: -3.0, x1: 43.0, y0: -3.0, y1: 43.0 };
+        assert_lines_cover(&m, &options(r, scan(region, angle, pick, false)))?;
+    }
+
+    /// A floor, spheres resting on it or floating over it, and a finite cylinder lying across:
+    /// every scan line is the envelope.
+    #[test]
+    fn analytic_composite_scan_lines_are_the_envelope(
+        balls in proptest::collection::vec((-20.0..20.0f64, -20.0..20.0f64, 0.0..25.0f64, 2.0..9.0f64), 1..4),
+        theta in 0.0..std::f64::consts::PI, cz in 3.0..15.0f64, rho in 0.5..4.0f64,
+        r in 0.8..6.0f64, angle in 0.0..180.0f64, pick in 2.0..5.0f64,
+    ) {
+        let mut surfaces = vec![r#"{"type": "plane", "point": [0, 0, 0], "normal": [0, 0, 1]}"#.to_string()];
+        for (x, y, z, big) in balls {
+            surfaces.push(format!(r#"{{"type": "sphere", "centre": [{x}, {y}, {}], "radius": {big}}}"#, z + big));
+        }
+        surfaces.push(format!(
+            r#"{{"type": "cylinder", "point": [0, 0, {cz}], "axis": [{}, {}, 0], "radius": {rho}, "length": [-15, 15]}}"#,
+            theta.cos(), theta.sin()
+        ));
+        let m = model(&format!(r#"{{"surfaces": [{}]}}"#, surfaces.join(",")));
+        let region = Region { x0: -25.0, x1: 25.0, y0: -25.0, y1: 25.0 };
+        assert_lines_cover(&m, &options(r, scan(region, angle, pick, false)))?;
     }
 }
