@@ -357,6 +357,41 @@ fn zmap_rows_one_feed_period_apart_agree() {
     assert!(worst < 1e-5, "rows 0.5 mm apart differ by {} µm", worst * 1e3);
 }
 
+/// Issue 20 R1: the cross-feed figures of a feed per tooth near zero are those of the circular
+/// cusp profile (closed form: Rz = r − √(r² − f²/4), Ra by integration), whatever the number of
+/// picks the patch spans; Rz never exceeds the surface's own height range.
+#[test]
+fn cross_feed_rz_ra_are_the_cusp_profiles() {
+    let w = Work::new();
+    let (r, p): (f64, f64) = (5.0, 0.5);
+    let a = p / 2.0;
+    let big_h = |u: f64| r * u - (u * (r * r - u * u).sqrt() + r * r * (u / r).asin()) / 2.0;
+    let m = r - (a * (r * r - a * a).sqrt() + r * r * (a / r).asin()) / (2.0 * a);
+    let u0 = (r * r - (r - m) * (r - m)).sqrt();
+    let ra = (2.0 / p) * (2.0 * m * u0 - 2.0 * big_h(u0) + big_h(a) - m * a) * 1e3;
+    let rz = (r - (r * r - a * a).sqrt()) * 1e3;
+    let t = tool();
+    for picks in ["1", "2.5", "3"] {
+        let args = ["patch", &t, "--pick", "0.5", "--feed-per-tooth", "0.00001", "--step", "0.001", "--picks", picks];
+        w.run(BIN, &[&args[..], &["--report", "c.json", "-o", "c.csv"]].concat(), b"").ok();
+        let rep = report(&w, "c.json");
+        let (got_rz, got_ra) = (num(&rep, "cross_feed_rz_um"), num(&rep, "cross_feed_ra_um"));
+        assert!((got_rz - rz).abs() < 0.01, "picks {picks}: Rz {got_rz} vs {rz} µm");
+        assert!((got_ra - ra).abs() < 0.01, "picks {picks}: Ra {got_ra} vs {ra} µm");
+    }
+    // Fig. 2 at 3°: Rz within the height range, and the same over 1, 2.5 and 3 picks (the
+    // cross-feed period is two picks with a 90° pass phase).
+    let cond = ["--step", "0.005", "--tilt", "3", "--lean", "minus-x", "--pass-phase", "90"];
+    let one = patch(&w, &cond);
+    assert!(num(&one, "cross_feed_rz_max_um") <= num(&one, "peak_to_valley_um") + 1e-9, "{one}");
+    for picks in ["2.5", "3"] {
+        let more = patch(&w, &[&cond[..], &["--picks", picks]].concat());
+        for key in ["cross_feed_rz_um", "cross_feed_rz_max_um", "cross_feed_ra_um", "feed_rz_um", "feed_ra_um"] {
+            assert!((num(&one, key) - num(&more, key)).abs() < 1e-3, "{key} over {picks} picks: {one} {more}");
+        }
+    }
+}
+
 /// Issue 20 P2, P3: a feed per tooth below the grid step divided by zero; a huge radius, a tiny
 /// pick feed or step allocated past --max-memory and aborted. Now: computed, or refused with
 /// one line naming the option and the estimate.

@@ -315,9 +315,11 @@ fn set_figures(r: &mut Report, c: &CellFigures) {
         .set("peak_to_valley_um", um(m.peak_to_valley))
         .set("grid_error_estimate_um", um(m.peak_to_valley - m.peak_to_valley_half))
         .set("cross_feed_rz_um", um(m.cross_rz))
+        .set("cross_feed_rz_max_um", um(m.cross_rz_max))
         .set("cross_feed_rz_at_y_mm", m.cross_rz_at)
         .set("cross_feed_ra_um", um(m.cross_ra))
         .set("feed_rz_um", um(m.feed_rz))
+        .set("feed_rz_max_um", um(m.feed_rz_max))
         .set("feed_rz_at_x_mm", m.feed_rz_at)
         .set("feed_ra_um", um(m.feed_ra))
         .set("down_cut_max_um", um(m.down_cut_max))
@@ -590,7 +592,7 @@ fn zmap_cmd(a: ZmapArgs) -> Result<()> {
     let seconds = started.elapsed().as_secs_f64();
     let cut: Vec<f64> = map.h.iter().copied().filter(|v| v.is_finite()).collect();
     let (lo, hi) = cut.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |a, &v| (a.0.min(v), a.1.max(v)));
-    let f = rough_sim::figures::figures(&map, f64::INFINITY, true);
+    let f = rough_sim::figures::figures(&map, f64::INFINITY, None, true);
     if let Some(path) = &a.svg {
         write_atomic(path, render::colour_map(&map, &format!("{}: z-map", input.name), lo).as_bytes())?;
     }
@@ -602,9 +604,9 @@ fn zmap_cmd(a: ZmapArgs) -> Result<()> {
             .set("nodes_cut", cut.len())
             .set("z_min_mm", lo)
             .set("z_max_mm", hi)
-            .set("row_rz_max_um", um(f.cross_rz))
+            .set("row_rz_max_um", um(f.cross_rz_max))
             .set("row_ra_mean_um", um(f.cross_ra))
-            .set("column_rz_max_um", um(f.feed_rz))
+            .set("column_rz_max_um", um(f.feed_rz_max))
             .set("column_ra_mean_um", um(f.feed_ra))
             .set("seconds", seconds);
         r.write(path)?;

@@ -226,18 +226,23 @@ fn column(cond: &Conditions, grid: &Grid, i: usize, out: &mut [f64]) {
 pub fn simulate(cond: &Conditions, grid: &Grid) -> HeightMap {
     match periods(cond, grid) {
         Some((m, p, d)) if grid.nx * grid.ny > m * p => {
-            let base = simulate_nodes(cond, &Grid { nx: m, ny: p, ..*grid });
-            let mut h = vec![0.0; grid.nx * grid.ny];
-            h.par_chunks_mut(grid.ny.max(1)).enumerate().for_each(|(i, col)| {
-                let (src, shift) = (base.column(i % m), (i / m) * d);
-                for (j, v) in col.iter_mut().enumerate() {
-                    *v = src[(j + shift) % p];
-                }
-            });
-            HeightMap { grid: *grid, h }
+            tile(&simulate_nodes(cond, &Grid { nx: m, ny: p, ..*grid }), (m, p, d), grid)
         }
         _ => simulate_nodes(cond, grid),
     }
+}
+
+/// The map on `grid` (same origin and step as `base`) repeating the first `m` columns and `p`
+/// rows of `base` with the periods `(m, p, d)` of [`periods`].
+pub fn tile(base: &HeightMap, (m, p, d): (usize, usize, usize), grid: &Grid) -> HeightMap {
+    let mut h = vec![0.0; grid.nx * grid.ny];
+    h.par_chunks_mut(grid.ny.max(1)).enumerate().for_each(|(i, col)| {
+        let (src, shift) = (base.column(i % m), (i / m) * d);
+        for (j, v) in col.iter_mut().enumerate() {
+            *v = src[(j + shift) % p];
+        }
+    });
+    HeightMap { grid: *grid, h }
 }
 
 /// The height map with every node computed (no use of the periods).
