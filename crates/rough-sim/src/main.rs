@@ -108,7 +108,7 @@ struct CondArgs {
     /// Grid step (mm).
     #[arg(long, default_value_t = 0.002, value_name = "MM")]
     step: f64,
-    /// Largest memory for heights (MB); larger grids are refused.
+    /// Largest memory (MB: heights and the passes' tracks), estimated before the run; more is refused.
     #[arg(long, default_value_t = DEFAULT_MEMORY / 1_000_000, value_name = "MB")]
     max_memory: u64,
     /// Largest work, in exact edge evaluations (about 1 µs each); larger runs are refused.
@@ -225,7 +225,7 @@ struct ZmapArgs {
     /// Area x0,y0,x1,y1 (mm); default: all the tool can reach.
     #[arg(long, allow_hyphen_values = true, value_name = "X0,Y0,X1,Y1")]
     area: Option<String>,
-    /// Largest memory for heights (MB).
+    /// Largest memory (MB: heights and moves), estimated before the run; more is refused.
     #[arg(long, default_value_t = DEFAULT_MEMORY / 1_000_000, value_name = "MB")]
     max_memory: u64,
     /// Largest work, in exact edge evaluations (about 1 µs each); larger runs are refused.
