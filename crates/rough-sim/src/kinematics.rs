@@ -33,6 +33,9 @@ pub const TIP_EPS: f64 = 1e-10;
 const SOLVE_TOL: f64 = 1e-14;
 /// Newton stops after a step shorter than this (rad): the error left is of its square's order.
 const NEWTON_STOP: f64 = 1e-7;
+/// Relative slack (of the angles' magnitude) within which a flute passing a piece's start is
+/// taken as passing it: a few ulps of G.
+const LEVEL_SLACK: f64 = 1e-12;
 /// Pieces are split until α changes by less than this along each (rad, below π).
 const PIECE_TURN: f64 = 3.0;
 
@@ -495,19 +498,29 @@ impl Track {
             let b0 = if g0 == p.g0 { p.big0 } else { self.big_in(p, g0) };
             let b1 = if g1 == p.g1 { p.big1 } else { self.big_in(p, g1) };
             let (bs, be) = if rightward { (b0, b1) } else { (b1, b0) };
+            // A flute passing at the start itself must not be lost to round-off in G: the
+            // first level is taken with a slack of a few ulps, and when it is the start's own
+            // value the crossing is there. (Without the slack, a node where the flute passes
+            // the lowest point of the arc exactly, e.g. a whole number of turns since the
+            // move's start, was cut by the next flute instead: up to 12.8 µm too high.)
+            let slack = LEVEL_SLACK * (c.abs() + bs.abs() + pitch);
             let level = if be >= bs {
-                let l = c + pitch * ((bs - c) / pitch).ceil();
+                let l = c + pitch * ((bs - c - slack) / pitch).ceil();
                 if l > be {
                     continue;
                 }
                 l
             } else {
-                let l = c + pitch * ((bs - c) / pitch).floor();
+                let l = c + pitch * ((bs - c + slack) / pitch).floor();
                 if l < be {
                     continue;
                 }
                 l
             };
+            if (bs - level).abs() <= slack {
+                let g = if rightward { g0 } else { g1 };
+                return Some(Bracket { piece: pi, lo: g, flo: 0.0, hi: g, fhi: 0.0, level });
+            }
             let (mut lo, mut flo, mut hi, mut fhi) = (g0, b0 - level, g1, b1 - level);
             // Narrow with the table (G is monotone on the piece).
             let tab = &self.table[p.table..=p.table + TABLE];
@@ -823,6 +836,33 @@ mod tests {
                 );
             }
         }
+    }
+
+    /// A 12 mm move at 1 mm per turn, two flutes: the cut repeats every 0.5 mm along it. At
+    /// y = 0 the spindle has turned exactly six times and flute 1 passes the arc's lowest point
+    /// over nodes beside the pass; that crossing was lost to round-off and the next flute's
+    /// taken, up to 12.8 µm too high (`rough-sim zmap`, the demo raster's y = 0 row).
+    #[test]
+    fn a_flute_at_the_lowest_point_of_the_arc_is_not_lost() {
+        let cutter = Cutter::ball(5.0, 2);
+        let span = 24.0 * PI;
+        let mv = Move {
+            c0: P3::new(0.0, -6.0, 5.0),
+            dc: V3::new(0.0, 12.0 / span, 0.0),
+            span,
+            phase: 0.0,
+            frame: Frame::about(V3::z()),
+        };
+        let mut worst: f64 = 0.0;
+        for i in 0..=300 {
+            let x = -0.75 + 0.005 * i as f64;
+            for y in [0.0, -1.5, 2.0] {
+                let a = lowest_cut(&cutter, &mv, x, y).expect("cut").z;
+                let b = lowest_cut(&cutter, &mv, x, y + 0.5).expect("cut").z;
+                worst = worst.max((a - b).abs());
+            }
+        }
+        assert!(worst < 1e-8, "cuts one feed per tooth apart differ by {} µm", worst * 1e3);
     }
 
     #[test]

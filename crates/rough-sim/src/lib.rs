@@ -6,9 +6,11 @@
 //! the edge points (eq. 1–5) over any straight move, [`patch`] the paper's straight passes on a
 //! grid, [`figures`] and [`study`] the roughness figures and sweeps, [`flat`] the flat tip of
 //! eq. 6–7, [`zmap`] any toolpath table on a z-map, [`brute`] the independent sampled check,
-//! [`render`] the CSV and SVG outputs.
+//! [`render`] the CSV and SVG outputs, [`budget`] the memory and work a run needs, estimated
+//! before it starts.
 
 pub mod brute;
+pub mod budget;
 pub mod cutter;
 pub mod figures;
 pub mod flat;

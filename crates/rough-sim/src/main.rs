@@ -7,6 +7,7 @@ use camkit::io::{Input, Output, write_atomic};
 use camkit::report::Report;
 use camkit::table::{self, Col};
 use clap::{Args, Parser, Subcommand, ValueEnum};
+use rough_sim::budget::{self, Budget, Need};
 use rough_sim::cutter::{Cutter, Rotation};
 use rough_sim::patch::{Conditions, DEFAULT_MEMORY, Grid, simulate};
 use rough_sim::render::Series;
@@ -107,9 +108,12 @@ struct CondArgs {
     /// Grid step (mm).
     #[arg(long, default_value_t = 0.002, value_name = "MM")]
     step: f64,
-    /// Largest memory for heights (MB); larger grids are refused.
+    /// Largest memory (MB: heights and the passes' tracks), estimated before the run; more is refused.
     #[arg(long, default_value_t = DEFAULT_MEMORY / 1_000_000, value_name = "MB")]
     max_memory: u64,
+    /// Largest work, in exact edge evaluations (about 1 µs each); larger runs are refused.
+    #[arg(long, default_value_t = budget::DEFAULT_WORK, value_name = "N")]
+    max_work: f64,
 }
 
 #[derive(Args, Debug)]
@@ -221,9 +225,12 @@ struct ZmapArgs {
     /// Area x0,y0,x1,y1 (mm); default: all the tool can reach.
     #[arg(long, allow_hyphen_values = true, value_name = "X0,Y0,X1,Y1")]
     area: Option<String>,
-    /// Largest memory for heights (MB).
+    /// Largest memory (MB: heights and moves), estimated before the run; more is refused.
     #[arg(long, default_value_t = DEFAULT_MEMORY / 1_000_000, value_name = "MB")]
     max_memory: u64,
+    /// Largest work, in exact edge evaluations (about 1 µs each); larger runs are refused.
+    #[arg(long, default_value_t = budget::DEFAULT_WORK, value_name = "N")]
+    max_work: f64,
     /// Write an SVG colour map.
     #[arg(long, value_name = "FILE")]
     svg: Option<PathBuf>,
@@ -245,6 +252,11 @@ fn positive(v: f64, what: &str) -> Result<f64> {
     if v.is_finite() && v > 0.0 { Ok(v) } else { Err(Error::input(format!("{what} must be positive, got {v}"))) }
 }
 
+/// The bounds of `--max-memory` (MB) and `--max-work`.
+fn budget_of(max_memory: u64, max_work: f64) -> Result<Budget> {
+    Ok(Budget { memory: max_memory.saturating_mul(1_000_000) as f64, work: positive(max_work, "--max-work")? })
+}
+
 /// The cutter and conditions of the arguments.
 fn conditions(a: &CondArgs) -> Result<(Conditions, Option<(f64, f64)>)> {
     let input = Input::open(&a.tool)?;
@@ -260,6 +272,7 @@ fn conditions(a: &CondArgs) -> Result<(Conditions, Option<(f64, f64)>)> {
     }
     doc.validate(&input.name)?;
     let mut cutter = Cutter::from_tool(&doc, &input.name, a.flutes)?;
+    budget::check_radius(cutter.radius, if a.radius.is_some() { "--radius" } else { &input.name })?;
     cutter.rotation = if a.rotation == Sense::Ccw { Rotation::Ccw } else { Rotation::Cw };
     let (fz, speeds) = match (a.feed_per_tooth, a.feed, a.spindle) {
         (Some(fz), None, None) => (positive(fz, "--feed-per-tooth")?, None),
@@ -302,9 +315,11 @@ fn set_figures(r: &mut Report, c: &CellFigures) {
         .set("peak_to_valley_um", um(m.peak_to_valley))
         .set("grid_error_estimate_um", um(m.peak_to_valley - m.peak_to_valley_half))
         .set("cross_feed_rz_um", um(m.cross_rz))
+        .set("cross_feed_rz_max_um", um(m.cross_rz_max))
         .set("cross_feed_rz_at_y_mm", m.cross_rz_at)
         .set("cross_feed_ra_um", um(m.cross_ra))
         .set("feed_rz_um", um(m.feed_rz))
+        .set("feed_rz_max_um", um(m.feed_rz_max))
         .set("feed_rz_at_x_mm", m.feed_rz_at)
         .set("feed_ra_um", um(m.feed_ra))
         .set("down_cut_max_um", um(m.down_cut_max))
@@ -334,7 +349,10 @@ fn patch(a: PatchArgs) -> Result<()> {
         None => (positive(a.picks, "--picks")? * cond.pick, positive(a.teeth, "--teeth")? * cond.feed_per_tooth),
     };
     let grid = Grid::covering(-w / 2.0, w / 2.0, 0.0, l, step);
-    grid.check_memory(a.cond.max_memory.saturating_mul(1_000_000))?;
+    let bounds = budget_of(a.cond.max_memory, a.cond.max_work)?;
+    budget::patch(&cond, &grid)
+        .check(&bounds, &format!("a {} × {} patch (--step, --pick, --feed-per-tooth)", grid.nx, grid.ny))?;
+    let spacing = positive(a.verify_spacing, "--verify-spacing")?;
     let progress = Progress::new(1, "simulating");
     let map = simulate(&cond, &grid);
     progress.finish();
@@ -353,8 +371,8 @@ fn patch(a: PatchArgs) -> Result<()> {
     if a.verify {
         let area = (-cond.pick / 2.0, cond.pick / 2.0, 0.0, cond.feed_per_tooth);
         let max_radial = (2.0 * cond.cutter.radius * (figs.map.max_height + 0.01)).sqrt().min(cond.cutter.radius);
-        let spacing = positive(a.verify_spacing, "--verify-spacing")?;
         let dtheta = brute::angle_step(max_radial, cond.feed_per_radian(), spacing);
+        budget::verify(&cond, area, dtheta, spacing, max_radial).check(&bounds, "--verify (--verify-spacing)")?;
         let (worst, samples) = brute::worst_below(&cond, area, dtheta, spacing, max_radial);
         report.set("verify_samples", samples).set("verify_worst_below_um", um(worst));
         if worst > rough_sim::STATED_ERROR {
@@ -403,13 +421,12 @@ fn sweep(a: SweepArgs) -> Result<()> {
         return Err(Error::input("--vary spindle needs --feed and --spindle (the feed is kept)"));
     }
     let radii = if a.radii.is_empty() { vec![base.cutter.radius] } else { a.radii.clone() };
-    let started = Instant::now();
-    let mut rows = vec![study::HEADER.to_string()];
-    let mut series = Vec::new();
-    let progress = Progress::new((radii.len() * a.values.len()) as u64, "sweeping");
-    for (ri, &r) in radii.iter().enumerate() {
+    // Every cell's conditions first, so the whole sweep is estimated before it starts.
+    let mut cells = Vec::new();
+    let mut need = Need::default();
+    for &r in &radii {
         positive(r, "--radii")?;
-        let (mut pts_max, mut pts_classic) = (Vec::new(), Vec::new());
+        budget::check_radius(r, "--radii")?;
         for &v in &a.values {
             let mut cond = Conditions { cutter: Cutter { radius: r, ..base.cutter }, ..base };
             let mut spindle = speeds.map(|s| s.1);
@@ -429,8 +446,20 @@ fn sweep(a: SweepArgs) -> Result<()> {
                 Vary::PassPhase => cond.pass_phase = v.to_radians(),
             }
             cond.validate()?;
-            let grid = study::cell_grid(&cond, a.cond.step);
-            grid.check_memory(a.cond.max_memory.saturating_mul(1_000_000))?;
+            need = need.then(budget::cell(&cond, a.cond.step));
+            cells.push((r, v, cond, spindle));
+        }
+    }
+    let bounds = budget_of(a.cond.max_memory, a.cond.max_work)?;
+    need.check(&bounds, &format!("a sweep of {} cells (--values, --radii, --step)", cells.len()))?;
+    let started = Instant::now();
+    let mut rows = vec![study::HEADER.to_string()];
+    let mut series = Vec::new();
+    let progress = Progress::new(cells.len() as u64, "sweeping");
+    for (ri, per_radius) in cells.chunks(a.values.len()).enumerate() {
+        let r = per_radius[0].0;
+        let (mut pts_max, mut pts_classic) = (Vec::new(), Vec::new());
+        for &(_, v, cond, spindle) in per_radius {
             let (_, figs) = study::cell(&cond, a.cond.step);
             rows.push(study::row(&cond, spindle, &figs));
             pts_max.push((v, figs.peak.0 * 1e3));
@@ -487,10 +516,17 @@ fn flat_tip(a: FlatArgs) -> Result<()> {
         let step = a.cond.step;
         let plain = Conditions { cutter: Cutter { flat_radius: 0.0, ..cond.cutter }, ..cond };
         let with = Conditions { cutter: Cutter { flat_radius: t.r0, ..cond.cutter }, ..cond };
+        let one = budget::cell(&plain, step);
+        let cells = 2.0 + budget::flat_cells(cond.cutter.radius, FLAT_RESOLUTION);
+        Need { memory: one.memory, work: one.work * cells }
+            .check(&budget_of(a.cond.max_memory, a.cond.max_work)?, "flat-tip --simulate (--step, --pick)")?;
         let (_, f_plain) = study::cell(&plain, step);
-        let (_, f_with) = study::cell(&with, step);
+        // Eq. 7 may ask for a flat as wide as the ball or wider (a large feed on a small tool):
+        // no such tool exists to simulate, and the row says so with NaN.
+        let with_height =
+            if with.cutter.validate().is_ok() { study::cell(&with, step).1.map.max_height } else { f64::NAN };
         rows.push(("max_height_plain_um", f_plain.map.max_height * 1e3));
-        rows.push(("max_height_with_r0_um", f_with.map.max_height * 1e3));
+        rows.push(("max_height_with_r0_um", with_height * 1e3));
         let sim = flat::simulated_r0(&plain, step, rough_sim::STATED_ERROR, FLAT_RESOLUTION).unwrap_or(f64::NAN);
         rows.push(("r0_simulated_mm", sim));
         rows.push(("delta_simulated_um", (cond.cutter.radius - (cond.cutter.radius.powi(2) - sim * sim).sqrt()) * 1e3));
@@ -516,6 +552,7 @@ fn zmap_cmd(a: ZmapArgs) -> Result<()> {
         return Err(Error::input("--flutes must be at least 1, got 0"));
     }
     let mut cutter = Cutter::from_tool(&doc, &tool_input.name, a.flutes)?;
+    budget::check_radius(cutter.radius, &tool_input.name)?;
     cutter.rotation = if a.rotation == Sense::Ccw { Rotation::Ccw } else { Rotation::Cw };
     let spindle = positive(a.spindle, "--spindle")?;
     if let Some(f) = a.feed {
@@ -528,7 +565,9 @@ fn zmap_cmd(a: ZmapArgs) -> Result<()> {
     if t.rows.is_empty() {
         return Err(Error::input("no rows: a toolpath is needed").at(Location::file(&input.name)));
     }
-    let moves = zmap::moves(&t, &input.name, &cutter, spindle, a.feed)?;
+    let bounds = budget_of(a.max_memory, a.max_work)?;
+    let max_moves = (bounds.memory / budget::MOVE_BYTES) as usize;
+    let moves = zmap::moves(&t, &input.name, &cutter, spindle, a.feed, max_moves)?;
     let (x0, y0, x1, y1) = if let Some(text) = &a.area {
         let v: Vec<f64> = text.split(',').filter_map(|t| camkit::num::parse_finite(t.trim()).ok()).collect();
         if v.len() != 4 {
@@ -543,12 +582,17 @@ fn zmap_cmd(a: ZmapArgs) -> Result<()> {
         return Err(Error::input("--area must be x0,y0,x1,y1 with x1 > x0 and y1 > y0"));
     }
     let grid = Grid::covering(x0, x1, y0, y1, a.step);
-    grid.check_memory(a.max_memory.saturating_mul(1_000_000))?;
+    let boxes = moves.iter().map(|m| {
+        let (p, q) = (m.c0, m.centre(m.span));
+        (p.x.min(q.x), p.y.min(q.y), p.x.max(q.x), p.y.max(q.y))
+    });
+    budget::zmap(&grid, boxes, cutter.radius, moves.len())
+        .check(&bounds, &format!("a {} × {} z-map of {} moves (--step, --area)", grid.nx, grid.ny, moves.len()))?;
     let map = zmap::simulate(&cutter, &moves, &grid);
     let seconds = started.elapsed().as_secs_f64();
     let cut: Vec<f64> = map.h.iter().copied().filter(|v| v.is_finite()).collect();
     let (lo, hi) = cut.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |a, &v| (a.0.min(v), a.1.max(v)));
-    let f = rough_sim::figures::figures(&map, f64::INFINITY, true);
+    let f = rough_sim::figures::figures(&map, f64::INFINITY, None, true);
     if let Some(path) = &a.svg {
         write_atomic(path, render::colour_map(&map, &format!("{}: z-map", input.name), lo).as_bytes())?;
     }
@@ -560,9 +604,9 @@ fn zmap_cmd(a: ZmapArgs) -> Result<()> {
             .set("nodes_cut", cut.len())
             .set("z_min_mm", lo)
             .set("z_max_mm", hi)
-            .set("row_rz_max_um", um(f.cross_rz))
+            .set("row_rz_max_um", um(f.cross_rz_max))
             .set("row_ra_mean_um", um(f.cross_ra))
-            .set("column_rz_max_um", um(f.feed_rz))
+            .set("column_rz_max_um", um(f.feed_rz_max))
             .set("column_ra_mean_um", um(f.feed_ra))
             .set("seconds", seconds);
         r.write(path)?;

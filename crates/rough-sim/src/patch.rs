@@ -87,18 +87,26 @@ impl Conditions {
         }
     }
 
-    /// Passes whose ball reaches x, nearest first.
-    fn passes_near(&self, x: f64) -> Vec<i64> {
-        let r = self.cutter.radius;
-        let lo = ((x - r) / self.pick).floor() as i64;
-        let hi = ((x + r) / self.pick).ceil() as i64;
-        let mut ks: Vec<i64> = (lo..=hi).filter(|&k| (x - k as f64 * self.pick).abs() < r).collect();
-        ks.sort_by(|a, b| {
-            let da = (x - *a as f64 * self.pick).abs();
-            let db = (x - *b as f64 * self.pick).abs();
-            da.total_cmp(&db).then(a.cmp(b))
-        });
-        ks
+    /// Passes whose ball reaches x, nearest first (ties: the lower index first), generated one
+    /// at a time: the callers stop once a pass's lowest possible cut is above the surface found,
+    /// so a large radius over a small pick feed never lists every pass the ball reaches.
+    pub fn passes_near(&self, x: f64) -> impl Iterator<Item = i64> + use<> {
+        let (r, pick) = (self.cutter.radius, self.pick);
+        let below = (x / pick).floor() as i64;
+        let (mut left, mut right) = (below, below.saturating_add(1));
+        std::iter::from_fn(move || {
+            let (dl, dr) = (x - left as f64 * pick, right as f64 * pick - x);
+            let (k, d) = if dl <= dr { (left, dl) } else { (right, dr) };
+            if d.abs() >= r {
+                return None;
+            }
+            if dl <= dr {
+                left = left.saturating_sub(1);
+            } else {
+                right = right.saturating_add(1);
+            }
+            Some(k)
+        })
     }
 }
 
@@ -122,24 +130,6 @@ impl Grid {
     pub fn covering(x0: f64, x1: f64, y0: f64, y1: f64, step: f64) -> Grid {
         let n = |len: f64| ((len / step) * (1.0 + 1e-12)).floor() as usize + 1;
         Grid { x0, y0, step, nx: n(x1 - x0), ny: n(y1 - y0) }
-    }
-
-    /// Checks the grid against a memory bound (bytes of heights).
-    pub fn check_memory(&self, bound: u64) -> Result<()> {
-        let bytes = (self.nx as u128) * (self.ny as u128) * 8;
-        if !(self.step.is_finite() && self.step > 0.0) {
-            return Err(Error::input(format!("grid step must be positive, got {}", self.step)));
-        }
-        if bytes > bound as u128 {
-            return Err(Error::input(format!(
-                "a {} × {} grid needs {:.0} MB, more than the bound of {} MB (--max-memory): coarsen the grid or shrink the area",
-                self.nx,
-                self.ny,
-                bytes as f64 / 1e6,
-                bound / 1_000_000
-            )));
-        }
-        Ok(())
     }
 
     /// x of column i.
@@ -199,27 +189,26 @@ fn column(cond: &Conditions, grid: &Grid, i: usize, out: &mut [f64]) {
     let x = grid.x(i);
     let (y_lo, y_hi) = (grid.y(0), grid.y(grid.ny.saturating_sub(1)));
     let reference = cond.reference();
-    // Passes nearest first, each with its move and lazily built track.
-    let passes: Vec<(Move, f64)> = cond
-        .passes_near(x)
-        .into_iter()
-        .map(|k| {
-            let mv = cond.pass(k, y_lo, y_hi);
-            let d = (x - mv.c0.x).abs();
-            let r = cond.cutter.radius;
-            // Lowest the ball can cut at this offset (a horizontal pass).
-            (mv, mv.c0.z - (r * r - d * d).max(0.0).sqrt())
-        })
-        .collect();
-    let mut tracks: Vec<Option<Track>> = vec![None; passes.len()];
+    let r = cond.cutter.radius;
+    // Passes nearest first, each with its move, the lowest the ball can cut at its offset (a
+    // horizontal pass) and its lazily built track; taken from `order` only when needed.
+    let mut order = cond.passes_near(x);
+    let mut passes: Vec<(Move, f64, Option<Track>)> = Vec::new();
     for (j, slot) in out.iter_mut().enumerate() {
         let y = grid.y(j);
         let mut best = f64::INFINITY;
-        for (p, (mv, bound)) in passes.iter().enumerate() {
+        for p in 0.. {
+            if p == passes.len() {
+                let Some(k) = order.next() else { break };
+                let mv = cond.pass(k, y_lo, y_hi);
+                let d = (x - mv.c0.x).abs();
+                passes.push((mv, mv.c0.z - (r * r - d * d).max(0.0).sqrt(), None));
+            }
+            let (mv, bound, track) = &mut passes[p];
             if *bound >= best {
                 break;
             }
-            let track = tracks[p].get_or_insert_with(|| Track::new(&cond.cutter, mv, x, y));
+            let track = track.get_or_insert_with(|| Track::new(&cond.cutter, mv, x, y));
             let mut cut = track.lowest(x, y);
             if cond.cutter.flat_radius > 0.0 {
                 cut = lower(cut, lowest_flat(&cond.cutter, mv, x, y));
@@ -237,18 +226,23 @@ fn column(cond: &Conditions, grid: &Grid, i: usize, out: &mut [f64]) {
 pub fn simulate(cond: &Conditions, grid: &Grid) -> HeightMap {
     match periods(cond, grid) {
         Some((m, p, d)) if grid.nx * grid.ny > m * p => {
-            let base = simulate_nodes(cond, &Grid { nx: m, ny: p, ..*grid });
-            let mut h = vec![0.0; grid.nx * grid.ny];
-            h.par_chunks_mut(grid.ny.max(1)).enumerate().for_each(|(i, col)| {
-                let (src, shift) = (base.column(i % m), (i / m) * d);
-                for (j, v) in col.iter_mut().enumerate() {
-                    *v = src[(j + shift) % p];
-                }
-            });
-            HeightMap { grid: *grid, h }
+            tile(&simulate_nodes(cond, &Grid { nx: m, ny: p, ..*grid }), (m, p, d), grid)
         }
         _ => simulate_nodes(cond, grid),
     }
+}
+
+/// The map on `grid` (same origin and step as `base`) repeating the first `m` columns and `p`
+/// rows of `base` with the periods `(m, p, d)` of [`periods`].
+pub fn tile(base: &HeightMap, (m, p, d): (usize, usize, usize), grid: &Grid) -> HeightMap {
+    let mut h = vec![0.0; grid.nx * grid.ny];
+    h.par_chunks_mut(grid.ny.max(1)).enumerate().for_each(|(i, col)| {
+        let (src, shift) = (base.column(i % m), (i / m) * d);
+        for (j, v) in col.iter_mut().enumerate() {
+            *v = src[(j + shift) % p];
+        }
+    });
+    HeightMap { grid: *grid, h }
 }
 
 /// The height map with every node computed (no use of the periods).
@@ -270,7 +264,8 @@ pub fn periods(cond: &Conditions, grid: &Grid) -> Option<(usize, usize, usize)> 
     let fz = cond.feed_per_tooth;
     let shift = cond.cutter.rotation.sign() * cond.pass_phase * cond.feed_per_radian();
     let (m, p, d) = (whole(cond.pick / grid.step)?, whole(fz / grid.step)?, whole(shift.rem_euclid(fz) / grid.step)?);
-    (m >= 1 && p >= 1).then_some((m, p, d % p))
+    // Lazily: with a feed per tooth below the step p is 0 and d % p would divide by zero.
+    (m >= 1 && p >= 1).then(|| (m, p, d % p))
 }
 
 /// A period is a whole number of grid steps when within this fraction of one (the position
@@ -323,6 +318,31 @@ mod tests {
             let worst = tiled.h.iter().zip(&every.h).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
             assert!(worst < 1e-10, "phase {phase}: {worst} mm");
         }
+    }
+
+    /// A feed per tooth below the grid step has no whole period in y (it used to divide by
+    /// zero: `sweep --values 1e-12 --step 0.02`, exit 101).
+    #[test]
+    fn no_period_below_one_step() {
+        let cond = paper(1e-12, 2, 0.0);
+        let grid = Grid::covering(-0.25, 0.25, 0.0, cond.feed_per_tooth, 0.02);
+        assert_eq!(periods(&cond, &grid), None);
+        let map = simulate(&cond, &grid);
+        assert_eq!(map.h.len(), 26);
+        assert!(map.h.iter().all(|v| v.is_finite()));
+    }
+
+    /// The passes come nearest first, exactly those the ball reaches, and a huge number of
+    /// reachable passes is not listed up front.
+    #[test]
+    fn passes_nearest_first() {
+        let cond = paper(0.5, 2, 0.0);
+        let ks: Vec<i64> = cond.passes_near(0.3).collect();
+        let mut want: Vec<i64> = (-20..=20).filter(|&k| (0.3 - k as f64 * 0.5).abs() < 5.0).collect();
+        want.sort_by(|a, b| (0.3 - *a as f64 * 0.5).abs().total_cmp(&(0.3 - *b as f64 * 0.5).abs()).then(a.cmp(b)));
+        assert_eq!(ks, want);
+        let wide = Conditions { pick: 1e-9, ..cond };
+        assert_eq!(wide.passes_near(0.0).take(3).collect::<Vec<_>>(), vec![0, -1, 1]);
     }
 
     #[test]

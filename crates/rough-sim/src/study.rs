@@ -2,7 +2,7 @@
 //! per tooth, tilt and spindle speed (paper 003 fig. 4b, fig. 5b, §3.2).
 
 use crate::figures::{Figures, classic_peak, cusp_classic, cusp_exact, figures};
-use crate::patch::{Conditions, Grid, HeightMap, node_source, simulate};
+use crate::patch::{Conditions, Grid, HeightMap, node_source, periods, simulate, tile};
 
 /// Heights above the classic peak by less than this (mm) are not called a remainder: the
 /// solver's and grid's error stays well below it.
@@ -42,7 +42,15 @@ pub fn cell(cond: &Conditions, step: f64) -> (HeightMap, CellFigures) {
 /// Figures of a simulated map of `cond`.
 pub fn cell_figures(cond: &Conditions, map: &HeightMap) -> CellFigures {
     let r = cond.cutter.radius;
-    let f = figures(map, cond.pick, cond.cutter.rotation.sign() > 0.0);
+    let down_left = cond.cutter.rotation.sign() > 0.0;
+    let sampling = Some((cond.pick, cond.feed_per_tooth));
+    let mut f = figures(map, cond.pick, sampling, down_left);
+    if let Some(period) = period_map(cond, map) {
+        let p = figures(&period, cond.pick, sampling, down_left);
+        (f.cross_rz, f.cross_rz_max, f.cross_rz_at, f.cross_ra) =
+            (p.cross_rz, p.cross_rz_max, p.cross_rz_at, p.cross_ra);
+        (f.feed_rz, f.feed_rz_max, f.feed_rz_at, f.feed_ra) = (p.feed_rz, p.feed_rz_max, p.feed_rz_at, p.feed_ra);
+    }
     let classic = classic_peak(r, cond.pick, cond.feed_per_tooth);
     let peak = refine_peak(cond, f.max_height, f.max_at, map.grid.step);
     let remainder = if peak.0 > classic + REMAINDER_MARGIN { peak.0 } else { 0.0 };
@@ -54,6 +62,35 @@ pub fn cell_figures(cond: &Conditions, map: &HeightMap) -> CellFigures {
         peak,
         remainder,
     }
+}
+
+/// Most picks a cross-feed period may span for the profiles to be taken over it.
+const MAX_PERIOD_PICKS: usize = 16;
+
+/// One whole period of the surface, from `map`'s first node, when the grid fits the periods:
+/// q pick feeds across (q passes shift the surface along the feed by a whole number of feeds
+/// per tooth; q > 1 with a pass phase) by one feed per tooth along, end nodes included. The
+/// profiles' figures are taken over it, so they do not depend on the patch's extent.
+fn period_map(cond: &Conditions, map: &HeightMap) -> Option<HeightMap> {
+    let (m, p, d) = periods(cond, &map.grid)?;
+    if map.grid.nx < m || map.grid.ny < p {
+        return None;
+    }
+    let q = p / gcd(d, p);
+    if q > MAX_PERIOD_PICKS {
+        return None;
+    }
+    // Start halfway between passes (x = −f/2 + k·f), as the cell does, so the sampling lengths
+    // lie between the same passes whatever the patch's extent.
+    let g = &map.grid;
+    let i0 = ((-0.5 * cond.pick - g.x0) / g.step).round().rem_euclid(m as f64) as usize;
+    let ny = p + 1;
+    let wide = tile(map, (m, p, d), &Grid { nx: i0 + q * m + 1, ny, ..*g });
+    Some(HeightMap { grid: Grid { x0: g.x(i0), nx: q * m + 1, ny, ..*g }, h: wide.h[i0 * ny..].to_vec() })
+}
+
+fn gcd(a: usize, b: usize) -> usize {
+    if b == 0 { a } else { gcd(b, a % b) }
 }
 
 /// Zooms in on the neighbourhood of the grid's highest node: four rounds of 11 × 11 exact

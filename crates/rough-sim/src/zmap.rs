@@ -21,8 +21,15 @@ pub const ARC_CHORD: f64 = 1e-5;
 const TILE: usize = 32;
 
 /// The moves of a toolpath table, with the spindle at `spindle` rpm; `feed` is used where the
-/// table has no `f`.
-pub fn moves(table: &Table, file: &str, cutter: &Cutter, spindle: f64, feed: Option<f64>) -> Result<Vec<Move>> {
+/// table has no `f`. More than `max_moves` (arcs chorded) is refused as bad input.
+pub fn moves(
+    table: &Table,
+    file: &str,
+    cutter: &Cutter,
+    spindle: f64,
+    feed: Option<f64>,
+    max_moves: usize,
+) -> Result<Vec<Move>> {
     let r = cutter.radius;
     let mut out = Vec::new();
     for pass in table.passes() {
@@ -54,6 +61,12 @@ pub fn moves(table: &Table, file: &str, cutter: &Cutter, spindle: f64, feed: Opt
             }
             let axis = (axis_a + axis_b).normalize();
             let tips = chord_points(a.pos, b, file)?;
+            if out.len() + tips.len() > max_moves {
+                return Err(Error::input(format!(
+                    "more than {max_moves} moves (arcs chorded within {ARC_CHORD} mm) do not fit the bound of --max-memory"
+                ))
+                .at(Location::file(file).line(b.line)));
+            }
             let mut prev = a.pos;
             for (idx, tip) in tips.iter().enumerate() {
                 let len = (tip - prev).norm();
