@@ -35,6 +35,11 @@ pub trait Problem<const N: usize>: Sync {
     fn retract(&self, s: &Self::State, delta: &SVector<f64, N>) -> Self::State;
     /// Typical size (mm) of the state's coordinates: steps are judged relative to it.
     fn scale(&self, s: &Self::State) -> f64;
+    /// True when the state has run off where no solution can be (a radius far beyond the points'
+    /// spread, as on points nearly on a plane): the iteration stops there and the caller reports it.
+    fn runaway(&self, _s: &Self::State) -> bool {
+        false
+    }
 }
 
 /// Normal equations at one state: `JᵀWJ`, `JᵀWr`, the weighted sum of squares.
@@ -166,6 +171,9 @@ pub fn minimise<const N: usize, P: Problem<N>>(
             n = m;
             iterations += 1;
             lambda = (lambda / 10.0).max(1e-12);
+            if problem.runaway(&state) {
+                return Ok(Solution { state, normal: n, iterations });
+            }
         } else {
             lambda *= 10.0;
             if lambda > 1e30 {
