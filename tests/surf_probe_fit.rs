@@ -224,6 +224,10 @@ fn coastline_on_the_fitted_sphere_is_offset_normal_to_the_tool_axis() {
     assert!(v["largest_tip_deviation_mm"].as_f64().unwrap() <= tol, "{v}");
     w.write("bad.json", r#"{"parts": [[[140, 40]]]}"#);
     w.run(BIN, &["map", "bad.json", "--frame", "frame.json", "-o", "x.csv"], b"").fails(2, "parts[0]");
+    w.write("bad.json", r#"{"parts": [[[140, 40], [141, 40]]], "sorce": "typo"}"#);
+    w.run(BIN, &["map", "bad.json", "--frame", "frame.json", "-o", "x.csv"], b"").fails(2, "bad.json:1:");
+    w.write("bad.json", r#"{"parts": [[[140, 40], [141, 95]]]}"#);
+    w.run(BIN, &["map", "bad.json", "--frame", "frame.json", "-o", "x.csv"], b"").fails(2, "(parts[0][1])");
 }
 
 #[test]
@@ -299,4 +303,285 @@ fn ransac_drops_gross_outliers_reproducibly() {
     w.write("four.csv", "x,y,z\n0,0,0\n1,1,1\n2,4,8\n3,9,27\n");
     w.run(BIN, &["fit", "four.csv", "--robust", "ransac", "-o", "x.json"], b"").fails(2, "sample of 4");
     assert!(!w.exists("x.json"), "no partial output");
+}
+
+/// Shape, truth and frame documents are read strictly: unknown fields, typos, strings for
+/// numbers, a radius that is not positive and duplicate keys are refused with file:line:col and
+/// the JSON path (they were accepted, or refused without a line, before), and a negative radius
+/// never reaches the simulation.
+#[test]
+fn shape_and_frame_documents_are_read_strictly() {
+    let w = Work::new();
+    let truth = d("surf-probe-fit/globe-true.json");
+    w.run(BIN, &["raster", "--x", "-8,14", "--y", "-11,7", "--step", "2", "--z", "115.5", "-o", "raster.csv"], b"")
+        .ok();
+    w.run(BIN, &["simulate", "raster.csv", "--shape", &truth, "-o", "rec.csv"], b"").ok();
+    w.run(BIN, &["points", "rec.csv", "-o", "pts.csv"], b"").ok();
+    w.run(BIN, &["fit", "pts.csv", "-o", "frame.json"], b"").ok();
+    let cases = [
+        (
+            "typo.json",
+            r#"{"shape": "sphere", "centre": [3.2, -1.7, 40.5], "radius": 25.0, "radious": 3}"#,
+            "typo.json:1:",
+        ),
+        (
+            "unknown.json",
+            r#"{"bogus_field": 1, "shape": "sphere", "centre": [3.2, -1.7, 40.5], "radius": 25.0}"#,
+            "(bogus_field): unknown field",
+        ),
+        (
+            "string.json",
+            r#"{"shape": "sphere", "centre": ["5", -1.7, 40.5], "radius": 25.0}"#,
+            "string.json:1:34 (centre[0]): invalid type: string",
+        ),
+        (
+            "negative.json",
+            "{\"shape\": \"sphere\", \"centre\": [3.2, -1.7, 40.5],\n \"radius\": -1}",
+            "negative.json:2:14 (radius): must be a positive number of mm, got -1",
+        ),
+        (
+            "twice.json",
+            r#"{"shape": "sphere", "centre": [3.2, -1.7, 40.5], "radius": 25, "radius": 26}"#,
+            "duplicate field `radius`",
+        ),
+    ];
+    for (name, text, needle) in cases {
+        w.write(name, text);
+        w.run(BIN, &["simulate", "raster.csv", "--shape", name, "-o", "x.csv"], b"").fails(2, needle);
+        w.run(BIN, &["fit", "pts.csv", "--truth", name, "-o", "x.json"], b"").fails(2, needle);
+    }
+    // A frame document: its own fields by camkit's Frame, its fit as a shape document.
+    let frame = w.read("frame.json");
+    w.write("xc.json", frame.replacen("\"xc\": ", "\"xc\": \"5\", \"was\": ", 1));
+    w.run(BIN, &["map", &d("surf-probe-fit/honshu-coastline.json"), "--frame", "xc.json", "-o", "x.csv"], b"")
+        .fails(2, "xc.json:2:");
+    w.write("fitr.json", frame.replacen("\"radius\": ", "\"radious\": 1, \"radius\": ", 1));
+    w.run(BIN, &["plan", "--fit", "fitr.json", "-o", "x.csv"], b"").fails(2, "(fit.radious): unknown field");
+    w.write("cyl.json", r#"{"shape": "cylinder", "point": [0, 0, 0], "axis": [0, 0, 1]}"#);
+    w.run(BIN, &["fit", "pts.csv", "--truth", "cyl.json", "-o", "x.json"], b"").fails(2, "(radius): a cylinder needs");
+    w.write("plane.json", r#"{"shape": "plane", "point": [0, 0, 0], "normal": [0, 0, 1]}"#);
+    w.run(BIN, &["fit", "pts.csv", "--truth", "plane.json", "-o", "x.json"], b"")
+        .fails(2, "the true element is a plane, the fit a sphere");
+    assert!(!w.exists("x.csv") && !w.exists("x.json"));
+}
+
+/// Every numeric option must be a finite number in its range: NaN no longer reaches the output
+/// tables (`reference --amplitude NaN` wrote NaN coordinates, exit 0).
+#[test]
+fn numeric_options_are_finite_and_in_range() {
+    let w = Work::new();
+    let coast = d("surf-probe-fit/honshu-coastline.json");
+    let frame = d("surf-probe-fit/globe-true.json");
+    let cases: [(&[&str], &str); 9] = [
+        (&["reference", "--amplitude", "NaN"], "'--amplitude <AMPLITUDE>': expected a finite number, found \"NaN\""),
+        (&["reference", "--centre", "NaN,0,0"], "--centre"),
+        (&["reference", "--radius", "inf"], "--radius"),
+        (&["reference", "--amplitude", "-1"], "--amplitude must be from 0"),
+        (&["reference", "--extent", "200"], "--extent (a sphere's cap half-angle) must be from 0 to 180°"),
+        (&["map", &coast, "--frame", &frame, "--lon0", "NaN"], "--lon0"),
+        (&["map", &coast, "--frame", &frame, "--lon0", "1e300"], "--lon0 must be from -360 to 360°"),
+        (&["plan", "--fit", &frame, "--max-polar", "-5"], "--max-polar must be from 0 to 180°"),
+        (&["raster", "--x", "0,10", "--y", "0,10", "--z", "1e300"], "--z must be from -1000000 to 1000000 mm"),
+    ];
+    for (args, needle) in cases {
+        w.run(BIN, &[args, &["-o", "x.csv"]].concat(), b"").fails(2, needle);
+    }
+    assert!(!w.exists("x.csv"));
+}
+
+/// The work of the generating sub-commands is estimated from the options before anything is
+/// allocated, and refused past `--max-points` (they aborted on allocation before).
+#[test]
+fn work_past_the_bound_is_refused_before_it_starts() {
+    let w = Work::new();
+    let coast = d("surf-probe-fit/honshu-coastline.json");
+    let frame = d("surf-probe-fit/globe-true.json");
+    let cases: [(&[&str], &str); 5] = [
+        (&["raster", "--x", "0,1e5", "--y", "0,10", "--step", "1e-9", "--z", "10"], "the raster of --x, --y at --step"),
+        (
+            &["reference", "--points", "1000000000000"],
+            "--points would give 1.0000e12 rows, more than --max-points 1000000",
+        ),
+        (
+            &["map", &coast, "--frame", &frame, "--lon0", "138", "--step", "1e-9"],
+            "--step 0.000000001° along the outlines",
+        ),
+        (&["plan", "--fit", &frame, "--ring-step", "1e-9"], "--ring-step"),
+        (&["reference", "--max-points", "100000000000"], "--max-points must be at most 10000000"),
+    ];
+    for (args, needle) in cases {
+        w.run(BIN, &[args, &["-o", "x.csv"]].concat(), b"").fails(2, needle);
+    }
+    // The bound can be raised (and lowered).
+    w.run(BIN, &["reference", "--points", "2000", "--max-points", "1999", "-o", "x.csv"], b"").fails(2, "--points");
+    w.run(BIN, &["reference", "--points", "2000", "--max-points", "2000", "-o", "ok.csv"], b"").ok();
+    assert_eq!(w.read("ok.csv").lines().count(), 2001);
+    assert!(!w.exists("x.csv"));
+}
+
+/// Column names of raw records match without regard to case, as the table reader's own columns do
+/// (`READING` was "missing column `reading`").
+#[test]
+fn record_columns_match_in_any_case() {
+    let w = Work::new();
+    let truth = d("surf-probe-fit/globe-true.json");
+    w.run(BIN, &["raster", "--x", "-8,14", "--y", "-11,7", "--step", "2", "--z", "115.5", "-o", "raster.csv"], b"")
+        .ok();
+    w.run(BIN, &["simulate", "raster.csv", "--shape", &truth, "-o", "rec.csv"], b"").ok();
+    let rec = w.read("rec.csv");
+    let (head, body) = rec.split_once('\n').unwrap();
+    w.write("upper.csv", format!("{}\n{body}", head.to_uppercase()));
+    let lower = w.run(BIN, &["points", "rec.csv"], b"").ok();
+    assert_eq!(w.run(BIN, &["points", "upper.csv"], b"").ok(), lower);
+    w.write("both.csv", format!("{head},READING\n{}", body.replace('\n', ",1\n")));
+    w.run(BIN, &["points", "both.csv"], b"").fails(2, "are the same column `reading`");
+}
+
+/// `--truth` compares a cylinder by its axis line and a plane by its offset and normal (a perfect
+/// fit reported 0.427 mm and 10 mm: distances between unrelated points), and a 5° cap reaches the
+/// exact least-squares solution (7.3e-7 mm off before).
+#[test]
+fn truth_errors_mean_something_for_each_kind() {
+    let w = Work::new();
+    let run = |set: &str, shape: &str, truth: &str| -> serde_json::Value {
+        let args = ["fit", &d(set), "--shape", shape, "--truth", &d(truth), "-o", "f.json", "--report", "r.json"];
+        w.run(BIN, &args, b"").ok();
+        json(&w, "r.json")
+    };
+    let r = run("surf-probe-fit/cylinder_half_s7.csv", "cylinder", "surf-probe-fit/cylinder_half_s7.truth.json");
+    assert!(r.get("origin_error_mm").is_none(), "{r}");
+    assert!(r["axis_distance_mm"].as_f64().unwrap() < 1e-3, "{r}");
+    assert!(r["axis_angle_deg"].as_f64().unwrap() < 1e-2, "{r}");
+    assert!(r["radius_error_mm"].as_f64().unwrap().abs() < 1e-3, "{r}");
+    let r = run("surf-probe-fit/plane_tilted_s7.csv", "plane", "surf-probe-fit/plane_tilted_s7.truth_shifted.json");
+    assert!(r.get("origin_error_mm").is_none(), "{r}");
+    assert!(r["plane_offset_mm"].as_f64().unwrap().abs() < 1e-3, "{r}");
+    assert!(r["normal_angle_deg"].as_f64().unwrap() < 1e-2, "{r}");
+    let r = run("surf-probe-fit/cap5_seed51.csv", "sphere", "surf-probe-fit/cap5_seed51.truth.json");
+    assert!(r["origin_error_mm"].as_f64().unwrap() <= 1e-9, "{r}");
+    assert!(r["radius_error_mm"].as_f64().unwrap().abs() <= 1e-9, "{r}");
+}
+
+/// Seeded fuzz of every numeric option of every sub-command with extreme, tiny, negative, huge,
+/// non-finite and non-numeric values: each run ends with 0, 1 or 2 (no panic, no signal) under a
+/// 4 GiB address-space bound and a time bound, and writes no NaN, infinity or null.
+#[test]
+fn every_numeric_option_survives_extreme_values() {
+    let w = Work::new();
+    let truth = d("surf-probe-fit/globe-true.json");
+    let coast = d("surf-probe-fit/honshu-coastline.json");
+    w.run(BIN, &["raster", "--x", "-8,14", "--y", "-11,7", "--step", "2", "--z", "115.5", "-o", "raster.csv"], b"")
+        .ok();
+    w.run(BIN, &["simulate", "raster.csv", "--shape", &truth, "-o", "rec.csv"], b"").ok();
+    w.run(BIN, &["points", "rec.csv", "-o", "pts.csv"], b"").ok();
+    w.run(BIN, &["fit", "pts.csv", "-o", "frame.json"], b"").ok();
+    let values = [
+        "0",
+        "-0",
+        "1e-300",
+        "-1e-300",
+        "1e-9",
+        "-1",
+        "0.5",
+        "3",
+        "4",
+        "90",
+        "181",
+        "1e6",
+        "1e7",
+        "1e300",
+        "-1e300",
+        "NaN",
+        "inf",
+        "-inf",
+        "1e400",
+        "x",
+        "",
+        "18446744073709551616",
+        "1000000000000",
+    ];
+    // Sub-command, its fixed arguments, and each numeric option with how a value goes in.
+    let raster: &[&str] = &["raster", "--x", "-8,14", "--y", "-11,7", "--z", "115.5"];
+    let simulate: &[&str] = &["simulate", "raster.csv", "--shape", &truth];
+    let plan_sphere: &[&str] = &["plan", "--fit", "frame.json"];
+    let plan_rough: &[&str] = &["plan", "pts.csv"];
+    let fit_huber: &[&str] = &["fit", "pts.csv", "--robust", "huber"];
+    let fit_ransac: &[&str] = &["fit", "pts.csv", "--robust", "ransac", "--max-hypotheses", "200"];
+    let map: &[&str] = &["map", &coast, "--frame", "frame.json"];
+    let options: Vec<(&[&str], &str, &str)> = vec![
+        (raster, "--x", "{},14"),
+        (raster, "--y", "-11,{}"),
+        (raster, "--step", "{}"),
+        (raster, "--z", "{}"),
+        (raster, "--max-points", "{}"),
+        (simulate, "--standoff", "{}"),
+        (simulate, "--range", "{}"),
+        (simulate, "--noise", "{}"),
+        (simulate, "--slope-error", "{}"),
+        (simulate, "--max-incidence", "{}"),
+        (simulate, "--seed", "{}"),
+        (plan_sphere, "--standoff", "{}"),
+        (plan_sphere, "--max-polar", "{}"),
+        (plan_sphere, "--ring-step", "{}"),
+        (plan_sphere, "--max-points", "{}"),
+        (plan_rough, "--every", "{}"),
+        (plan_rough, "--max-slope", "{}"),
+        (&["reference"], "--centre", "{},0,0"),
+        (&["reference", "--shape", "cylinder"], "--axis", "0,{},1"),
+        (&["reference", "--shape", "circle"], "--radius", "{}"),
+        (&["reference", "--shape", "plane"], "--extent", "{}"),
+        (&["reference"], "--extent", "{}"),
+        (&["reference"], "--points", "{}"),
+        (&["reference"], "--amplitude", "{}"),
+        (&["reference"], "--seed", "{}"),
+        (fit_huber, "--huber-k", "{}"),
+        (fit_ransac, "--ransac-threshold", "{}"),
+        (fit_ransac, "--confidence", "{}"),
+        (fit_ransac, "--seed", "{}"),
+        (&["fit", "pts.csv", "--robust", "ransac"], "--max-hypotheses", "{}"),
+        (&["fit", "pts.csv"], "--max-amplification", "{}"),
+        (&["surface", "pts.csv"], "--net", "{},8"),
+        (map, "--lon0", "{}"),
+        (map, "--step", "{}"),
+        (map, "--depth", "{}"),
+        (map, "--max-points", "{}"),
+    ];
+    let mut state = 0x2545_f491_4f6c_dd1du64;
+    let mut next = || {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        state
+    };
+    let mut runs = 0;
+    for (base, option, form) in &options {
+        let mut picks: Vec<&str> = vec!["NaN", "1e300", "1e-9", "0"];
+        picks.extend((0..5).map(|_| values[(next() % values.len() as u64) as usize]));
+        for v in picks {
+            let value = form.replace("{}", v);
+            let args: Vec<&str> = base.iter().copied().chain([*option, value.as_str()]).collect();
+            let out = std::process::Command::new("sh")
+                .arg("-c")
+                .arg("ulimit -v 4194304; exec timeout 60 \"$0\" \"$@\"")
+                .arg(e2e::bin(BIN))
+                .args(&args)
+                .current_dir(w.path(""))
+                .output()
+                .expect("run");
+            let status = out.status.code().unwrap_or(-1);
+            let stderr = String::from_utf8_lossy(&out.stderr);
+            assert!((0..=2).contains(&status), "{args:?}: status {status}, stderr {stderr}");
+            assert!(!stderr.contains("internal error") && !stderr.contains("panicked"), "{args:?}: {stderr}");
+            if status != 0 {
+                assert_eq!(stderr.trim_end().lines().count(), 1, "{args:?}: one line: {stderr}");
+            }
+            let text = String::from_utf8_lossy(&out.stdout).to_lowercase();
+            assert!(
+                !text.contains("nan") && !text.contains("inf") && !text.contains("null"),
+                "{args:?}: non-finite output"
+            );
+            runs += 1;
+        }
+    }
+    assert!(runs >= 300, "{runs} runs");
 }

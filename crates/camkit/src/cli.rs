@@ -61,6 +61,46 @@ pub fn positive(v: f64, what: &str) -> Result<f64> {
     }
 }
 
+/// Parses the command line of a filter for [`run`]: help and version print and exit 0 as clap
+/// does; a usage error (an unknown option, a value its parser refuses) becomes a one-line input
+/// error naming the option (exit 2), like every other bad input.
+pub fn parse<C: clap::Parser>() -> Result<C> {
+    C::try_parse().map_err(|e| {
+        use clap::error::ErrorKind;
+        if matches!(
+            e.kind(),
+            ErrorKind::DisplayHelp | ErrorKind::DisplayVersion | ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand
+        ) {
+            e.exit();
+        }
+        let text = e.render().to_string();
+        let first = text.lines().next().unwrap_or("bad arguments");
+        Error::input(first.strip_prefix("error: ").unwrap_or(first).to_string())
+    })
+}
+
+/// A clap value parser for numeric options: a finite number (`NaN`, `inf` and overflowing values
+/// are refused with the option named, exit 2), in the message shape of the table readers. Use as
+/// `#[arg(long, value_parser = camkit::cli::finite)]`.
+pub fn finite(text: &str) -> std::result::Result<f64, String> {
+    crate::num::parse_finite(text).map_err(|e| e.message(text))
+}
+
+/// A command-line number that must lie in `lo..=hi` (`what` names the option and `unit` its
+/// unit, for the message).
+pub fn within(v: f64, lo: f64, hi: f64, what: &str, unit: &str) -> Result<f64> {
+    if v >= lo && v <= hi {
+        Ok(v)
+    } else {
+        Err(Error::input(format!("{what} must be from {lo} to {hi}{unit}, got {}", short(v))))
+    }
+}
+
+/// A number as a message shows it: plain, or in exponent form when very large or small.
+fn short(v: f64) -> String {
+    if v != 0.0 && !(1e-6..1e9).contains(&v.abs()) { format!("{v:e}") } else { v.to_string() }
+}
+
 /// What a filter reads or writes: the toolpath table or G-code, or decided by the input's name.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum Kind {
@@ -135,5 +175,21 @@ impl Progress {
     /// Removes the bar.
     pub fn finish(&self) {
         self.bar.finish_and_clear();
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn numeric_options_are_finite_and_in_range() {
+        assert_eq!(finite(" 2.5"), Ok(2.5));
+        assert_eq!(finite("NaN").unwrap_err(), "expected a finite number, found \"NaN\"");
+        assert!(finite("inf").is_err() && finite("1e400").is_err() && finite("x").is_err());
+        assert_eq!(within(3.0, 0.0, 90.0, "--angle", "°").unwrap(), 3.0);
+        let e = within(-1.0, 0.0, 90.0, "--angle", "°").unwrap_err();
+        assert_eq!((e.to_string().as_str(), e.exit_status()), ("--angle must be from 0 to 90°, got -1", 2));
+        assert!(within(1e300, 0.0, 1.0, "--x", "").unwrap_err().to_string().ends_with("got 1e300"));
     }
 }

@@ -10,6 +10,14 @@ pub fn direction(lon: f64, lat: f64, lon0: f64) -> V3 {
     V3::new(la.cos() * lo.cos(), la.cos() * lo.sin(), la.sin())
 }
 
+/// The number of points [`map_outline`] gives (in floating point, so a tiny step gives a huge
+/// number, not an overflow): the work and memory of a map, known before it is made.
+pub fn outline_points(lonlat: &[[f64; 2]], lon0: f64, step_deg: f64) -> f64 {
+    let dirs: Vec<V3> = lonlat.iter().map(|p| direction(p[0], p[1], lon0)).collect();
+    let edges: f64 = dirs.windows(2).map(|w| (w[0].angle(&w[1]).to_degrees() / step_deg).ceil().max(1.0)).sum();
+    edges + if dirs.is_empty() { 0.0 } else { 1.0 }
+}
+
 /// One outline on the sphere: points `radius · n` and normals `n`, edges split along their great
 /// circle so no step is longer than `step_deg` degrees of arc; a closed outline repeats its first
 /// point at the end.
@@ -36,6 +44,15 @@ pub fn map_outline(lonlat: &[[f64; 2]], radius: f64, lon0: f64, step_deg: f64) -
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_estimate_is_the_count() {
+        let outline = [[130.0, 33.0], [135.5, 34.2], [141.9, 40.1], [130.0, 33.0]];
+        for step in [0.5, 1.0, 7.0, 90.0] {
+            assert_eq!(outline_points(&outline, 138.0, step), map_outline(&outline, 25.0, 138.0, step).len() as f64);
+        }
+        assert!(outline_points(&outline, 138.0, 1e-9) > 1e10);
+    }
 
     #[test]
     fn points_lie_on_the_sphere_along_great_circles() {

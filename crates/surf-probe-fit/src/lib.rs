@@ -6,8 +6,10 @@
 //! through the machine's kinematics ([`records`]), the 3-axis raster as a rough Delaunay surface
 //! and the 5-axis measuring plan along its normals ([`rough`]), and the fit as the workpiece frame
 //! `post-6axis` reads ([`frame`]), and outlines by longitude and latitude mapped onto a fitted
-//! sphere ([`globe`]); for free-form parts, a bicubic B-spline height field ([`heightfield`]).
+//! sphere ([`globe`]); for free-form parts, a bicubic B-spline height field ([`heightfield`]); a
+//! fit's errors against a known element ([`truth`]); the shape document, read strictly ([`document`]).
 
+pub mod document;
 pub mod frame;
 pub mod globe;
 pub mod heightfield;
@@ -19,6 +21,7 @@ pub mod rng;
 pub mod rough;
 pub mod sensor;
 pub mod shapes;
+pub mod truth;
 
 pub use ransac::Ransac;
 pub use shapes::{Fit, FitError, Kind, Options, Robust, Shape, fit};

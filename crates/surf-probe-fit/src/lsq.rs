@@ -14,9 +14,14 @@ const CHUNK: usize = 8192;
 /// Largest number of Levenberg–Marquardt trials before a fit is declared not converged.
 pub const MAX_TRIALS: usize = 200;
 
-/// A step shorter than this, relative to the size of the parameters, ends the iteration: the
-/// parameters are then at the floating-point floor of the minimum.
-const STEP_REL: f64 = 1e-13;
+/// The iteration ends when the undamped Gauss–Newton step is shorter than this, relative to the
+/// size of the parameters: they are then at the floating-point floor of the minimum (a few ulps
+/// of the largest coordinate, whatever the conditioning: the step is the gradient's, not a
+/// fixed tolerance's).
+const STEP_REL: f64 = 1e-14;
+
+/// Relative round-off of one distance (a few ulps of the coordinates it is computed from).
+const DISTANCE_ULPS: f64 = 8.0 * f64::EPSILON;
 
 /// A geometric fit problem: signed orthogonal distances of points from a shape described by a
 /// state, with the gradient of each distance with respect to `N` local parameters.
@@ -30,6 +35,11 @@ pub trait Problem<const N: usize>: Sync {
     fn retract(&self, s: &Self::State, delta: &SVector<f64, N>) -> Self::State;
     /// Typical size (mm) of the state's coordinates: steps are judged relative to it.
     fn scale(&self, s: &Self::State) -> f64;
+    /// True when the state has run off where no solution can be (a radius far beyond the points'
+    /// spread, as on points nearly on a plane): the iteration stops there and the caller reports it.
+    fn runaway(&self, _s: &Self::State) -> bool {
+        false
+    }
 }
 
 /// Normal equations at one state: `JᵀWJ`, `JᵀWr`, the weighted sum of squares.
@@ -99,6 +109,14 @@ pub struct Solution<S, const N: usize> {
 }
 
 /// Minimises `Σ wᵢ dᵢ²` from `start` by Levenberg–Marquardt (Marquardt's diagonal scaling).
+///
+/// Convergence is judged by the gradient, not by a damped step or a fixed tolerance: the
+/// iteration ends when the undamped Gauss–Newton step `−(JᵀWJ)⁻¹JᵀWr` is below [`STEP_REL`] of
+/// the parameters' size. Once the decrease that step promises is below the round-off of the cost
+/// itself, the cost can no longer tell better from worse: Gauss–Newton steps are then taken as
+/// long as each shortens the next one (the gradient still knows the way), and the iteration ends
+/// at the first that does not. So ill-conditioned fits (a small cap of a sphere) reach the
+/// floating-point floor instead of stopping where the cost goes flat.
 pub fn minimise<const N: usize, P: Problem<N>>(
     problem: &P,
     start: P::State,
@@ -113,6 +131,24 @@ pub fn minimise<const N: usize, P: Problem<N>>(
     let mut lambda = 1e-4;
     let mut iterations = 0;
     for trial in 0..MAX_TRIALS {
+        let scale = 1.0 + problem.scale(&state);
+        if let Some(gn) = gauss_newton(&n) {
+            if gn.norm() <= STEP_REL * scale {
+                return Ok(Solution { state, normal: n, iterations });
+            }
+            if -gn.dot(&n.jtr) <= cost_roundoff(n.cost, points.len(), scale) {
+                let next = problem.retract(&state, &gn);
+                let m = normal(problem, &next, points, w);
+                let shorter = gauss_newton(&m).is_some_and(|g| g.norm() < gn.norm());
+                if !(shorter && m.cost <= n.cost + cost_roundoff(n.cost, points.len(), scale)) {
+                    return Ok(Solution { state, normal: n, iterations });
+                }
+                state = next;
+                n = m;
+                iterations += 1;
+                continue;
+            }
+        }
         let mut a = n.jtj;
         for k in 0..N {
             a[(k, k)] += lambda * n.jtj[(k, k)].max(f64::MIN_POSITIVE);
@@ -128,10 +164,6 @@ pub fn minimise<const N: usize, P: Problem<N>>(
         if !delta.iter().all(|d| d.is_finite()) {
             return Err(Failure::Diverged);
         }
-        let floor = STEP_REL * (1.0 + problem.scale(&state));
-        if delta.norm() <= floor {
-            return Ok(Solution { state, normal: n, iterations });
-        }
         let next = problem.retract(&state, &delta);
         let m = normal(problem, &next, points, w);
         if m.cost.is_finite() && m.cost <= n.cost {
@@ -139,18 +171,31 @@ pub fn minimise<const N: usize, P: Problem<N>>(
             n = m;
             iterations += 1;
             lambda = (lambda / 10.0).max(1e-12);
-        } else {
-            lambda *= 10.0;
-            // A rejected step this small means the cost is flat at round-off: the minimum.
-            if lambda > 1e12 && delta.norm() <= 1e3 * floor {
+            if problem.runaway(&state) {
                 return Ok(Solution { state, normal: n, iterations });
             }
+        } else {
+            lambda *= 10.0;
             if lambda > 1e30 {
                 return Err(Failure::NotConverged { trials: trial + 1 });
             }
         }
     }
     Err(Failure::NotConverged { trials: MAX_TRIALS })
+}
+
+/// The undamped Gauss–Newton step at `n`, if the normal equations are positive definite.
+fn gauss_newton<const N: usize>(n: &Normal<N>) -> Option<SVector<f64, N>> {
+    let step = -n.jtj.cholesky()?.solve(&n.jtr);
+    step.iter().all(|d| d.is_finite()).then_some(step)
+}
+
+/// Round-off of a cost `Σ rᵢ²` of `points` distances each computed from coordinates of size
+/// `scale`: `Σ (2|rᵢ| δr + δr²)` with `δr` a few ulps of `scale`, plus the sum's own rounding.
+fn cost_roundoff(cost: f64, points: usize, scale: f64) -> f64 {
+    let n = points as f64;
+    let dr = DISTANCE_ULPS * scale;
+    2.0 * (n * cost).sqrt() * dr + n * dr * dr + n * f64::EPSILON * cost
 }
 
 /// Standard uncertainties and conditioning of the local parameters at a solution.

@@ -1,6 +1,6 @@
 //! `surf-probe-fit`: on-machine measurement of a workpiece's shape and pose (paper 002 §2–4).
 
-use camkit::cli::{self, IoArgs, positive};
+use camkit::cli::{self, IoArgs, positive, within};
 use camkit::doc::machine::Machine;
 use camkit::error::{Error, Location, Result};
 use camkit::geom::{P3, V3};
@@ -13,6 +13,7 @@ use std::collections::HashMap;
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Instant;
+use surf_probe_fit::document::read_shape;
 use surf_probe_fit::records::{self, Record};
 use surf_probe_fit::reference::{self, Spec};
 use surf_probe_fit::rng::Rng;
@@ -116,14 +117,15 @@ struct FitArgs {
     #[arg(long, value_enum, default_value_t = RobustArg::None)]
     robust: RobustArg,
     /// Huber threshold in robust standard deviations.
-    #[arg(long, default_value_t = 1.345, value_name = "K")]
+    #[arg(long, default_value_t = 1.345, value_name = "K", value_parser = cli::finite)]
     huber_k: f64,
-    /// RANSAC inlier threshold on the orthogonal distance (mm); default 2.5 robust standard
-    /// deviations of the best hypothesis (least median of squares).
-    #[arg(long, value_name = "MM")]
+    /// RANSAC inlier threshold on the orthogonal distance (mm); default k(n) robust standard
+    /// deviations of the inliers (k(n): the Gaussian quantile any of n clean points exceeds with
+    /// probability 1 %, at least 3.5), so clean data give the plain fit.
+    #[arg(long, value_name = "MM", value_parser = cli::finite)]
     ransac_threshold: Option<f64>,
     /// RANSAC: wanted probability that some sample is free of outliers (sets the number of samples).
-    #[arg(long, default_value_t = Ransac::default().confidence, value_name = "P")]
+    #[arg(long, default_value_t = Ransac::default().confidence, value_name = "P", value_parser = cli::finite)]
     confidence: f64,
     /// RANSAC: seed of the samples (the same seed gives the same fit).
     #[arg(long, default_value_t = Ransac::default().seed)]
@@ -132,7 +134,7 @@ struct FitArgs {
     #[arg(long, default_value_t = Ransac::default().max_hypotheses, value_name = "N")]
     max_hypotheses: usize,
     /// Noise amplification above which a parameter is reported as poorly determined.
-    #[arg(long, default_value_t = shapes::DEFAULT_MAX_AMPLIFICATION, value_name = "FACTOR")]
+    #[arg(long, default_value_t = shapes::DEFAULT_MAX_AMPLIFICATION, value_name = "FACTOR", value_parser = cli::finite)]
     max_amplification: f64,
     /// The true element (a shape or frame document): its errors go into the report.
     #[arg(long, value_name = "FILE")]
@@ -153,40 +155,90 @@ struct OutArgs {
     report: Option<PathBuf>,
 }
 
+/// The work bound of the sub-commands that generate rows: the rows are estimated from the options
+/// before anything is allocated, and a run past the bound is refused (exit 2) naming the option.
+#[derive(clap::Args, Debug)]
+struct LimitArgs {
+    /// Refuse (exit 2) a run whose output would have more than N rows (estimated from the options
+    /// before any work; each row costs about 200 bytes of memory). At most 10 000 000.
+    #[arg(long, default_value_t = DEFAULT_MAX_POINTS, value_name = "N")]
+    max_points: usize,
+}
+
+/// Default of `--max-points`.
+const DEFAULT_MAX_POINTS: usize = 1_000_000;
+
+/// Largest `--max-points` (about 2 GB of rows).
+const MAX_POINTS_CAP: usize = 10_000_000;
+
+/// Largest coordinate or length on the command line (mm, 1 km): a machine's workspace, with room.
+const MAX_MM: f64 = 1e6;
+
+impl LimitArgs {
+    /// Refuses `estimate` rows past the bound; `what` names the options that set it.
+    fn check(&self, estimate: f64, what: &str) -> Result<()> {
+        if self.max_points > MAX_POINTS_CAP {
+            return Err(Error::input(format!(
+                "--max-points must be at most {MAX_POINTS_CAP}, got {}",
+                self.max_points
+            )));
+        }
+        if estimate > self.max_points as f64 {
+            return Err(Error::input(format!(
+                "{what} would give {estimate:.4e} rows, more than --max-points {}",
+                self.max_points
+            )));
+        }
+        Ok(())
+    }
+}
+
+/// A coordinate or length option within ±[`MAX_MM`].
+fn mm(v: f64, what: &str) -> Result<f64> {
+    within(v, -MAX_MM, MAX_MM, what, " mm")
+}
+
+/// A positive length option up to [`MAX_MM`].
+fn positive_mm(v: f64, what: &str) -> Result<f64> {
+    within(positive(v, what)?, 0.0, MAX_MM, what, " mm")
+}
+
 #[derive(clap::Args, Debug)]
 struct RasterArgs {
     #[command(flatten)]
     out: OutArgs,
+    #[command(flatten)]
+    limit: LimitArgs,
     /// X range `MIN,MAX` (mm).
-    #[arg(long, value_name = "MIN,MAX", value_delimiter = ',', allow_hyphen_values = true, required = true)]
+    #[arg(long, value_name = "MIN,MAX", value_delimiter = ',', allow_hyphen_values = true, required = true, value_parser = cli::finite)]
     x: Vec<f64>,
     /// Y range `MIN,MAX` (mm).
-    #[arg(long, value_name = "MIN,MAX", value_delimiter = ',', allow_hyphen_values = true, required = true)]
+    #[arg(long, value_name = "MIN,MAX", value_delimiter = ',', allow_hyphen_values = true, required = true, value_parser = cli::finite)]
     y: Vec<f64>,
     /// Spacing of the raster in X and Y (mm).
-    #[arg(long, default_value_t = 2.0, value_name = "MM")]
+    #[arg(long, default_value_t = 2.0, value_name = "MM", value_parser = cli::finite)]
     step: f64,
     /// Height of the sensor's reference point (mm).
-    #[arg(long, value_name = "MM")]
+    #[arg(long, value_name = "MM", value_parser = cli::finite)]
     z: f64,
 }
 
 #[derive(clap::Args, Debug)]
 struct SensorArgs {
     /// Sensor stand-off (mm): nominal distance from its reference point to the surface.
-    #[arg(long, default_value_t = Sensor::default().standoff, value_name = "MM")]
+    #[arg(long, default_value_t = Sensor::default().standoff, value_name = "MM", value_parser = cli::finite)]
     standoff: f64,
     /// Half measuring range about the stand-off (mm).
-    #[arg(long, default_value_t = Sensor::default().range, value_name = "MM")]
+    #[arg(long, default_value_t = Sensor::default().range, value_name = "MM", value_parser = cli::finite)]
     range: f64,
     /// Reading noise at normal incidence, standard deviation (mm).
-    #[arg(long, default_value_t = Sensor::default().noise, value_name = "MM")]
+    #[arg(long, default_value_t = Sensor::default().noise, value_name = "MM", value_parser = cli::finite)]
     noise: f64,
     /// Systematic error coefficient (mm): readings are longer by it × (1/cos θ − 1).
-    #[arg(long, default_value_t = Sensor::default().slope_error, value_name = "MM")]
+    #[arg(long, default_value_t = Sensor::default().slope_error, value_name = "MM", value_parser = cli::finite)]
     slope_error: f64,
     /// Largest incidence angle that returns a reading (degrees).
-    #[arg(long, default_value_t = Sensor::default().max_incidence, value_name = "DEG")]
+    #[arg(long, default_value_t = Sensor::default().max_incidence, value_name = "DEG", value_parser = cli::finite)]
     max_incidence: f64,
 }
 
@@ -220,23 +272,25 @@ struct PointsArgs {
 struct PlanArgs {
     #[command(flatten)]
     io: IoArgs,
+    #[command(flatten)]
+    limit: LimitArgs,
     /// Plan on this fitted sphere (a frame or shape document) instead of the rough surface.
     #[arg(long, value_name = "FILE")]
     fit: Option<String>,
     /// Sensor stand-off (mm): the pose's tip is this far from the surface along the normal.
-    #[arg(long, default_value_t = Sensor::default().standoff, value_name = "MM")]
+    #[arg(long, default_value_t = Sensor::default().standoff, value_name = "MM", value_parser = cli::finite)]
     standoff: f64,
     /// Rough surface: probe every N-th point.
     #[arg(long, default_value_t = 1, value_name = "N")]
     every: usize,
     /// Rough surface: facets steeper than this are dropped (degrees).
-    #[arg(long, default_value_t = 80.0, value_name = "DEG")]
+    #[arg(long, default_value_t = 80.0, value_name = "DEG", value_parser = cli::finite)]
     max_slope: f64,
     /// Sphere: largest angle from the top (degrees).
-    #[arg(long, default_value_t = 80.0, value_name = "DEG")]
+    #[arg(long, default_value_t = 80.0, value_name = "DEG", value_parser = cli::finite)]
     max_polar: f64,
     /// Sphere: spacing of rings and of points along them (degrees).
-    #[arg(long, default_value_t = 10.0, value_name = "DEG")]
+    #[arg(long, default_value_t = 10.0, value_name = "DEG", value_parser = cli::finite)]
     ring_step: f64,
 }
 
@@ -244,26 +298,28 @@ struct PlanArgs {
 struct ReferenceArgs {
     #[command(flatten)]
     out: OutArgs,
+    #[command(flatten)]
+    limit: LimitArgs,
     /// Element.
     #[arg(long, value_enum, default_value_t = ShapeArg::Sphere)]
     shape: ShapeArg,
     /// Centre (sphere, circle) or axis point (cylinder) or plane point `X,Y,Z`.
-    #[arg(long, value_delimiter = ',', allow_hyphen_values = true, default_values_t = [0.0, 0.0, 0.0])]
+    #[arg(long, value_delimiter = ',', allow_hyphen_values = true, default_values_t = [0.0, 0.0, 0.0], value_parser = cli::finite)]
     centre: Vec<f64>,
     /// Normal (plane, circle) or axis (cylinder) `X,Y,Z`.
-    #[arg(long, value_delimiter = ',', allow_hyphen_values = true, default_values_t = [0.0, 0.0, 1.0])]
+    #[arg(long, value_delimiter = ',', allow_hyphen_values = true, default_values_t = [0.0, 0.0, 1.0], value_parser = cli::finite)]
     axis: Vec<f64>,
     /// Radius (mm).
-    #[arg(long, default_value_t = 25.0)]
+    #[arg(long, default_value_t = 25.0, value_parser = cli::finite)]
     radius: f64,
     /// Sphere: cap half-angle (deg); cylinder: length (mm); plane: half-width (mm); circle: arc (deg).
-    #[arg(long, default_value_t = 180.0)]
+    #[arg(long, default_value_t = 180.0, value_parser = cli::finite)]
     extent: f64,
     /// Number of points.
     #[arg(long, default_value_t = 1000)]
     points: usize,
     /// Residual amplitude (mm).
-    #[arg(long, default_value_t = 0.01)]
+    #[arg(long, default_value_t = 0.01, value_parser = cli::finite)]
     amplitude: f64,
     /// Random seed.
     #[arg(long, default_value_t = 1)]
@@ -324,22 +380,26 @@ fn run_surface(args: SurfaceArgs) -> Result<()> {
 struct MapArgs {
     #[command(flatten)]
     io: IoArgs,
+    #[command(flatten)]
+    limit: LimitArgs,
     /// The frame document of a sphere fit (its radius is used; the workpiece origin is the centre).
     #[arg(long, value_name = "FILE")]
     frame: String,
     /// Longitude (degrees) that faces +X.
-    #[arg(long, default_value_t = 0.0, value_name = "DEG")]
+    #[arg(long, default_value_t = 0.0, value_name = "DEG", value_parser = cli::finite)]
     lon0: f64,
     /// Largest arc (degrees) between consecutive points along an edge.
-    #[arg(long, default_value_t = 0.5, value_name = "DEG")]
+    #[arg(long, default_value_t = 0.5, value_name = "DEG", value_parser = cli::finite)]
     step: f64,
     /// Depth (mm) of the tool tip below the surface, along the normal.
-    #[arg(long, default_value_t = 0.0, value_name = "MM")]
+    #[arg(long, default_value_t = 0.0, value_name = "MM", value_parser = cli::finite)]
     depth: f64,
 }
 
-/// The outlines document: `{"parts": [[[lon, lat], ...], ...]}` (degrees), with free `source`.
+/// The outlines document: `{"parts": [[[lon, lat], ...], ...]}` (degrees), with free `source`;
+/// other fields and duplicate keys are refused.
 #[derive(serde::Deserialize)]
+#[serde(deny_unknown_fields)]
 struct Outlines {
     parts: Vec<Vec<[f64; 2]>>,
     #[serde(default)]
@@ -350,13 +410,16 @@ fn run_map(args: MapArgs) -> Result<()> {
     let Shape::Sphere { radius, .. } = read_shape(&args.frame)? else {
         return Err(Error::input("--frame must hold a sphere fit").at(Location::file(&args.frame)));
     };
-    positive(args.step, "--step")?;
-    if !(args.depth.is_finite() && args.depth >= 0.0 && args.depth < radius) {
-        return Err(Error::input("--depth must be from 0 to the sphere's radius"));
+    within(positive(args.step, "--step")?, 0.0, 180.0, "--step", "°")?;
+    within(args.lon0, -360.0, 360.0, "--lon0", "°")?;
+    if !(args.depth >= 0.0 && args.depth < radius) {
+        return Err(Error::input(format!(
+            "--depth must be from 0 to the sphere's radius {radius} mm, got {}",
+            args.depth
+        )));
     }
     let input = Input::open(&args.io.input)?;
     let doc: Outlines = camkit::json::from_input(&input)?;
-    let mut t = pose_table(&[]);
     for (k, part) in doc.parts.iter().enumerate() {
         if part.len() < 2 || part.iter().flatten().any(|v| !v.is_finite()) {
             return Err(camkit::json::field_error(
@@ -365,6 +428,18 @@ fn run_map(args: MapArgs) -> Result<()> {
                 "an outline needs at least two finite [lon, lat] points",
             ));
         }
+        if let Some(j) = part.iter().position(|p| p[0].abs() > 360.0 || p[1].abs() > 90.0) {
+            return Err(camkit::json::field_error(
+                &input.name,
+                &format!("parts[{k}][{j}]"),
+                format!("[lon, lat] must lie within ±360° and ±90°, got {:?}", part[j]),
+            ));
+        }
+    }
+    let estimate: f64 = doc.parts.iter().map(|part| globe::outline_points(part, args.lon0, args.step)).sum();
+    args.limit.check(estimate, &format!("--step {}° along the outlines", args.step))?;
+    let mut t = pose_table(&[]);
+    for (k, part) in doc.parts.iter().enumerate() {
         for (j, (p, n)) in globe::map_outline(part, radius, args.lon0, args.step).iter().enumerate() {
             let mut row = Row::at(k as i64, p - n * args.depth);
             row.mv = if j == 0 { Move::Rapid } else { Move::Line };
@@ -384,7 +459,7 @@ fn run_map(args: MapArgs) -> Result<()> {
 }
 
 fn main() -> ExitCode {
-    cli::run("surf-probe-fit", || match Cli::parse().command {
+    cli::run("surf-probe-fit", || match cli::parse::<Cli>()?.command {
         Command::Fit(a) => run_fit(a),
         Command::Raster(a) => run_raster(a),
         Command::Simulate(a) => run_simulate(a),
@@ -407,25 +482,26 @@ fn table_chain(machine: Option<&str>) -> Result<(Chain, f64)> {
     }
 }
 
-/// A shape document: `{"shape": "sphere", "centre": [..], "radius": ..}`, or a frame document
-/// whose `fit` holds one.
-fn read_shape(path: &str) -> Result<Shape> {
-    let input = Input::open(path)?;
-    let v: serde_json::Value = camkit::json::from_input(&input)?;
-    let (v, at) = match v.get("fit") {
-        Some(f) => (f.clone(), "fit"),
-        None => (v, "shape"),
-    };
-    serde_json::from_value::<Shape>(v).map_err(|e| camkit::json::field_error(&input.name, at, e.to_string()))
-}
-
 /// Column position (1-based) of the extra column `i` in the header.
 fn extra_column(schema: &Schema, i: usize) -> u64 {
     schema.fields.iter().position(|f| *f == Field::Extra(i)).map_or(0, |p| p as u64 + 1)
 }
 
+/// The extra column `name` matched without regard to case, as the table reader matches its known
+/// columns (`READING` is `reading`); two columns that differ only in case are refused.
+fn extra_index(t: &Table, name: &str, file: &str) -> Result<Option<usize>> {
+    let mut found = t.schema.extra_names.iter().enumerate().filter(|(_, n)| n.eq_ignore_ascii_case(name));
+    let first = found.next();
+    if let (Some((_, a)), Some((_, b))) = (first, found.next()) {
+        return Err(
+            Error::input(format!("columns `{a}` and `{b}` are the same column `{name}`")).at(Location::file(file))
+        );
+    }
+    Ok(first.map(|(i, _)| i))
+}
+
 fn extra_number(t: &Table, row: &Row, name: &str, file: &str) -> Result<Option<f64>> {
-    let Some(i) = t.schema.extra_index(name) else { return Ok(None) };
+    let Some(i) = extra_index(t, name, file)? else { return Ok(None) };
     let text = row.extra[i].as_str();
     camkit::num::parse_finite(text).map(Some).map_err(|e| {
         Error::input(e.message(text))
@@ -455,7 +531,7 @@ fn read_records(t: &Table, chain: &Chain, file: &str) -> Result<Vec<Record>> {
 /// `x, y, z` columns otherwise. Duplicate points are refused.
 fn read_points(input: &Input, machine: Option<&str>) -> Result<(Table, Vec<P3>)> {
     let t = table::read(input, &[Col::X, Col::Y])?;
-    let pts: Vec<P3> = if t.schema.extra_index("reading").is_some() {
+    let pts: Vec<P3> = if extra_index(&t, "reading", &input.name)?.is_some() {
         let (chain, _) = table_chain(machine)?;
         read_records(&t, &chain, &input.name)?.iter().map(|r| records::to_point(&chain, r)).collect()
     } else {
@@ -476,25 +552,29 @@ fn run_fit(args: FitArgs) -> Result<()> {
     let started = Instant::now();
     let input = Input::open(&args.io.input)?;
     let (t, pts) = read_points(&input, args.machine.as_deref())?;
+    // Every option is checked, used or not: a wrong one is never silently ignored.
+    let huber_k = positive(args.huber_k, "--huber-k")?;
+    let threshold = args.ransac_threshold.map(|t| positive_mm(t, "--ransac-threshold")).transpose()?;
+    if !(args.confidence > 0.0 && args.confidence < 1.0) {
+        return Err(Error::input(format!("--confidence must be between 0 and 1 (exclusive), got {}", args.confidence)));
+    }
+    if !(1..=MAX_HYPOTHESES).contains(&args.max_hypotheses) {
+        return Err(Error::input(format!(
+            "--max-hypotheses must be from 1 to {MAX_HYPOTHESES}, got {}",
+            args.max_hypotheses
+        )));
+    }
     let opts = Options {
         max_amplification: positive(args.max_amplification, "--max-amplification")?,
         robust: match args.robust {
             RobustArg::None => Robust::None,
-            RobustArg::Huber => Robust::Huber(positive(args.huber_k, "--huber-k")?),
-            RobustArg::Ransac => {
-                if !(args.confidence > 0.0 && args.confidence < 1.0) {
-                    return Err(Error::input("--confidence must be between 0 and 1 (exclusive)"));
-                }
-                if args.max_hypotheses == 0 {
-                    return Err(Error::input("--max-hypotheses must be at least 1"));
-                }
-                Robust::Ransac(Ransac {
-                    threshold: args.ransac_threshold.map(|t| positive(t, "--ransac-threshold")).transpose()?,
-                    confidence: args.confidence,
-                    seed: args.seed,
-                    max_hypotheses: args.max_hypotheses,
-                })
-            }
+            RobustArg::Huber => Robust::Huber(huber_k),
+            RobustArg::Ransac => Robust::Ransac(Ransac {
+                threshold,
+                confidence: args.confidence,
+                seed: args.seed,
+                max_hypotheses: args.max_hypotheses,
+            }),
         },
     };
     let truth = args.truth.as_deref().map(read_shape).transpose()?;
@@ -539,8 +619,12 @@ fn run_fit(args: FitArgs) -> Result<()> {
                 .set("outlier_lines", lines);
         }
     }
-    if let Some(truth) = &truth {
-        truth_keys(&mut report, &f.shape, truth);
+    if let Some((truth, path)) = truth.as_ref().zip(args.truth.as_deref()) {
+        let errors =
+            surf_probe_fit::truth::errors(&f.shape, truth).map_err(|m| Error::input(m).at(Location::file(path)))?;
+        for (key, v) in errors {
+            report.set(key, v);
+        }
     }
     report.set("fit_seconds", fit_seconds).set("seconds", started.elapsed().as_secs_f64());
     let residuals = args.residuals.as_deref().map(|path| -> Result<Output> {
@@ -577,24 +661,14 @@ fn residual_table(mut t: Table, pts: &[P3], f: &surf_probe_fit::Fit) -> Table {
     t
 }
 
+/// Largest `--max-hypotheses` (the work bound of RANSAC: hypotheses × points distances).
+const MAX_HYPOTHESES: usize = 1_000_000;
+
 /// Decimals of the `residual` column (0.1 nm).
 const RESIDUAL_DECIMALS: usize = 7;
 
 /// Outlier lines named in the report (the first ones).
 const OUTLIER_LINES: usize = 20;
-
-/// Errors of the fitted element against the true one, in the report.
-fn truth_keys(report: &mut Report, got: &Shape, truth: &Shape) {
-    let origin_error = (frame::origin(got) - frame::origin(truth)).norm();
-    report.set("origin_error_mm", origin_error);
-    let radius = |s: &Shape| match s {
-        Shape::Sphere { radius, .. } | Shape::Circle { radius, .. } | Shape::Cylinder { radius, .. } => Some(*radius),
-        Shape::Plane { .. } => None,
-    };
-    if let (Some(a), Some(b)) = (radius(got), radius(truth)) {
-        report.set("radius_error_mm", a - b);
-    }
-}
 
 fn pose_table(extra: &[&str]) -> Table {
     let mut t = Table {
@@ -617,18 +691,22 @@ fn write_table(t: &Table, out: &OutArgs, report: &Report) -> Result<()> {
 }
 
 fn run_raster(args: RasterArgs) -> Result<()> {
-    let step = positive(args.step, "--step")?;
+    let step = positive_mm(args.step, "--step")?;
     if args.x.len() != 2 || args.y.len() != 2 {
         return Err(Error::input("--x and --y take two numbers: MIN,MAX"));
     }
+    for (v, what) in args.x.iter().map(|v| (v, "--x")).chain(args.y.iter().map(|v| (v, "--y"))) {
+        mm(*v, what)?;
+    }
+    mm(args.z, "--z")?;
     let (x0, x1, y0, y1) = (args.x[0], args.x[1], args.y[0], args.y[1]);
-    if !(x0 < x1 && y0 < y1 && args.z.is_finite()) {
-        return Err(Error::input("--x and --y must be ranges MIN,MAX with MIN < MAX, --z a number"));
+    if !(x0 < x1 && y0 < y1) {
+        return Err(Error::input("--x and --y must be ranges MIN,MAX with MIN < MAX"));
     }
-    let (nx, ny) = (((x1 - x0) / step).floor() as usize, ((y1 - y0) / step).floor() as usize);
-    if (nx + 1) * (ny + 1) > 10_000_000 {
-        return Err(Error::input("the raster would have more than 10 million poses: use a larger --step"));
-    }
+    // Counted in floating point: the product of two huge counts must not wrap.
+    let (fx, fy) = (((x1 - x0) / step).floor(), ((y1 - y0) / step).floor());
+    args.limit.check((fx + 1.0) * (fy + 1.0), &format!("the raster of --x, --y at --step {step}"))?;
+    let (nx, ny) = (fx as usize, fy as usize);
     let mut t = pose_table(&[]);
     for j in 0..=ny {
         let y = y0 + j as f64 * step;
@@ -649,11 +727,11 @@ fn run_simulate(args: SimulateArgs) -> Result<()> {
     let shape = read_shape(&args.shape)?;
     let s = &args.sensor;
     let sensor = Sensor {
-        standoff: positive(s.standoff, "--standoff")?,
-        range: positive(s.range, "--range")?,
-        noise: if s.noise >= 0.0 { s.noise } else { return Err(Error::input("--noise must not be negative")) },
-        slope_error: s.slope_error,
-        max_incidence: positive(s.max_incidence, "--max-incidence")?.min(90.0),
+        standoff: positive_mm(s.standoff, "--standoff")?,
+        range: positive_mm(s.range, "--range")?,
+        noise: within(s.noise, 0.0, MAX_MM, "--noise", " mm")?,
+        slope_error: mm(s.slope_error, "--slope-error")?,
+        max_incidence: within(positive(s.max_incidence, "--max-incidence")?, 0.0, 90.0, "--max-incidence", "°")?,
     };
     let input = Input::open(&args.io.input)?;
     let t = table::read(&input, &[Col::X, Col::Y])?;
@@ -718,16 +796,25 @@ fn run_points(args: PointsArgs) -> Result<()> {
 }
 
 fn run_plan(args: PlanArgs) -> Result<()> {
-    let standoff = positive(args.standoff, "--standoff")?;
+    let standoff = positive_mm(args.standoff, "--standoff")?;
+    within(args.max_slope, 0.0, 90.0, "--max-slope", "°")?;
+    within(args.max_polar, 0.0, 180.0, "--max-polar", "°")?;
+    within(positive(args.ring_step, "--ring-step")?, 0.0, 180.0, "--ring-step", "°")?;
+    if args.every == 0 {
+        return Err(Error::input("--every must be at least 1"));
+    }
     let mut report = Report::new("surf-probe-fit");
     report.set("command", "plan");
     let probes: Vec<Probe> = if let Some(path) = &args.fit {
         let Shape::Sphere { centre, radius } = read_shape(path)? else {
             return Err(Error::input("--fit must hold a sphere").at(Location::file(path)));
         };
-        positive(args.ring_step, "--ring-step")?;
+        let rings = (args.max_polar / args.ring_step).floor();
+        let estimate = 1.0 + rings * (360.0 / args.ring_step + 1.0).max(3.0);
+        args.limit
+            .check(estimate, &format!("--ring-step {}° up to --max-polar {}°", args.ring_step, args.max_polar))?;
         report.set("from", "sphere");
-        rough::plan_on_sphere(&P3::from(centre), radius, args.max_polar.clamp(0.0, 180.0), args.ring_step)
+        rough::plan_on_sphere(&P3::from(centre), radius, args.max_polar, args.ring_step)
     } else {
         let input = Input::open(&args.io.input)?;
         let t = table::read(&input, &[Col::X, Col::Y])?;
@@ -760,13 +847,27 @@ fn run_reference(args: ReferenceArgs) -> Result<()> {
     if args.centre.len() != 3 || args.axis.len() != 3 {
         return Err(Error::input("--centre and --axis take three numbers: X,Y,Z"));
     }
+    for v in &args.centre {
+        mm(*v, "--centre")?;
+    }
+    for v in &args.axis {
+        mm(*v, "--axis")?;
+    }
     let c = [args.centre[0], args.centre[1], args.centre[2]];
     let a = V3::new(args.axis[0], args.axis[1], args.axis[2]);
-    if a.norm().is_nan() || a.norm() == 0.0 {
+    if a.norm() == 0.0 {
         return Err(Error::input("--axis must be a non-zero vector"));
     }
     let a: [f64; 3] = a.normalize().into();
-    let r = positive(args.radius, "--radius")?;
+    let r = positive_mm(args.radius, "--radius")?;
+    let extent = match args.shape {
+        ShapeArg::Sphere => within(args.extent, 0.0, 180.0, "--extent (a sphere's cap half-angle)", "°"),
+        ShapeArg::Circle => within(args.extent, 0.0, 360.0, "--extent (a circle's arc)", "°"),
+        ShapeArg::Plane | ShapeArg::Cylinder => mm(args.extent, "--extent"),
+    };
+    let extent = positive(extent?, "--extent")?;
+    let amplitude = within(args.amplitude, 0.0, MAX_MM, "--amplitude", " mm")?;
+    args.limit.check(args.points as f64, "--points")?;
     let shape = match args.shape {
         ShapeArg::Sphere => Shape::Sphere { centre: c, radius: r },
         ShapeArg::Plane => Shape::Plane { point: c, normal: a },
@@ -777,13 +878,8 @@ fn run_reference(args: ReferenceArgs) -> Result<()> {
     if args.points < kind.parameters() + 1 {
         return Err(Error::input(format!("--points must be at least {}", kind.parameters() + 1)));
     }
-    let set = reference::generate(&Spec {
-        shape: shape.clone(),
-        points: args.points,
-        amplitude: args.amplitude,
-        extent: positive(args.extent, "--extent")?,
-        seed: args.seed,
-    });
+    let set =
+        reference::generate(&Spec { shape: shape.clone(), points: args.points, amplitude, extent, seed: args.seed });
     let mut t = Table { schema: Schema::of(&[Col::X, Col::Y, Col::Z]), rows: Vec::new() };
     t.rows.extend(set.points.iter().map(|p| Row::at(0, *p)));
     let mut report = Report::new("surf-probe-fit");

@@ -3,16 +3,23 @@
 //! [`crate::shapes`] until the inlier set settles.
 //!
 //! With a given inlier threshold the hypotheses are scored by MSAC's truncated cost
-//! `Σ min(rᵢ², t²)`; without one by the median of `rᵢ²` (least median of squares), and the
-//! threshold is `2.5 σ̂` with Rousseeuw's robust scale `σ̂ = 1.4826 (1 + 5/(n − s)) √med rᵢ²` of
-//! the best hypothesis. Each new best is replaced by the least-squares fit of its inliers when
-//! that scores better (LO-RANSAC), so the scale comes from a refit, not from a noisy minimal
+//! `Σ min(rᵢ², t²)`; without one by the median of `rᵢ²` (least median of squares) with
+//! Rousseeuw's robust scale `σ̂ = 1.4826 (1 + 5/(n − s)) √med rᵢ²` of the best hypothesis. Each new
+//! best is replaced by the least-squares fit of its inliers when that scores better (LO-RANSAC),
+//! so the scale comes from a refit, not from a noisy minimal
 //! sample. The number of hypotheses follows from the wanted confidence `p` and the
 //! best inlier ratio `w` seen so far: `N = ln(1 − p) / ln(1 − wˢ)` (without a given threshold
 //! `w` is taken as at most ½, the breakdown point of the median: a poor element's own threshold
 //! is wide and would count most points as its inliers). Samples come from one seeded
 //! generator and are scored in fixed batches in parallel, so the result is the same for any
 //! thread count and every run with the same seed.
+//!
+//! Without a given threshold it comes from the data's own scale, not a fixed share of the points:
+//! `t = k(n) σ̂` with `k(n)` the Gaussian quantile a clean set of `n` points exceeds anywhere with
+//! probability [`CLEAN_FLAG_PROBABILITY`] (Bonferroni; at least [`MIN_THRESHOLD_SIGMAS`]: 4.3 at
+//! 500 points), and after each refit `σ̂ = 1.4826 × median |r|` of the inliers. So a set with
+//! Gaussian noise and no outliers keeps every point and gives exactly the plain fit, while gross
+//! outliers (far beyond the noise) are all left out.
 
 use crate::rng::Rng;
 use crate::shapes::{self, Fit, FitError, Kind, Options, Robust, RobustInfo, Shape};
@@ -42,8 +49,12 @@ impl Default for Ransac {
 /// Hypotheses scored together (in parallel); the stopping rule is checked between batches.
 const BATCH: usize = 32;
 
-/// Threshold in robust standard deviations when it is not given (Rousseeuw and Leroy).
-const THRESHOLD_SIGMAS: f64 = 2.5;
+/// Without a given threshold: the probability that a clean set with Gaussian noise loses any
+/// point to the threshold (it is the Bonferroni quantile for this probability).
+pub const CLEAN_FLAG_PROBABILITY: f64 = 0.01;
+
+/// The smallest threshold in robust standard deviations (small sets).
+pub const MIN_THRESHOLD_SIGMAS: f64 = 3.5;
 
 /// The largest share of outliers the least median of squares tolerates: without a given
 /// threshold, the number of hypotheses assumes at most this inlier ratio.
@@ -137,7 +148,7 @@ fn score(shape: Shape, points: &[P3], threshold: Option<f64>, s: usize) -> Score
             let mid = r.len() / 2;
             let med = *r.select_nth_unstable_by(mid, f64::total_cmp).1;
             let scale = robust_scale(med, points.len(), s);
-            let t = threshold_of(scale);
+            let t = threshold_of(scale, points.len());
             Scored { cost: med, shape, inliers: r.iter().filter(|&&r| r <= t).count(), scale }
         }
     }
@@ -147,7 +158,7 @@ fn score(shape: Shape, points: &[P3], threshold: Option<f64>, s: usize) -> Score
 /// its inliers when that scores better; a minimal sample's element carries the noise of its few
 /// points, and the refit is what the final answer will be near.
 fn refine(h: Scored, kind: Kind, points: &[P3], opts: &Options, threshold: Option<f64>, s: usize) -> Scored {
-    let t = threshold.unwrap_or_else(|| threshold_of(h.scale));
+    let t = threshold.unwrap_or_else(|| threshold_of(h.scale, points.len()));
     let subset: Vec<P3> = points.iter().filter(|x| residual(&h.shape, x) <= t).copied().collect();
     if subset.len() <= s {
         return h;
@@ -167,9 +178,46 @@ fn robust_scale(median: f64, n: usize, s: usize) -> f64 {
     1.4826 * (1.0 + 5.0 / (n - s) as f64) * median
 }
 
-/// The inlier threshold a robust scale implies (never below round-off).
-fn threshold_of(scale: f64) -> f64 {
-    (THRESHOLD_SIGMAS * scale).max(camkit::tol::ROUNDOFF_ABS)
+/// The inlier threshold a robust scale implies for `n` points (never below round-off).
+fn threshold_of(scale: f64, n: usize) -> f64 {
+    (threshold_sigmas(n) * scale).max(camkit::tol::ROUNDOFF_ABS)
+}
+
+/// `k(n)`: the distance in standard deviations that any of `n` Gaussian residuals exceeds with
+/// probability [`CLEAN_FLAG_PROBABILITY`] (`2n Q(k) = p`, Q the upper normal tail), at least
+/// [`MIN_THRESHOLD_SIGMAS`].
+pub fn threshold_sigmas(n: usize) -> f64 {
+    let want = CLEAN_FLAG_PROBABILITY / (2.0 * n.max(1) as f64);
+    let (mut lo, mut hi) = (MIN_THRESHOLD_SIGMAS, 40.0);
+    if normal_tail(lo) <= want {
+        return lo;
+    }
+    for _ in 0..100 {
+        let mid = 0.5 * (lo + hi);
+        if normal_tail(mid) > want { lo = mid } else { hi = mid }
+    }
+    hi
+}
+
+/// Upper tail `Q(k) = P(Z > k)` of the standard normal distribution (Numerical Recipes' `erfcc`,
+/// relative error below 1.2e-7).
+fn normal_tail(k: f64) -> f64 {
+    let z = k / std::f64::consts::SQRT_2;
+    let t = 1.0 / (1.0 + 0.5 * z);
+    let poly = -z * z - 1.26551223
+        + t * (1.00002368
+            + t * (0.37409196
+                + t * (0.09678418
+                    + t * (-0.18628806
+                        + t * (0.27886807
+                            + t * (-1.13520398 + t * (1.48851587 + t * (-0.82215223 + t * 0.17087277))))))));
+    0.5 * t * poly.exp()
+}
+
+/// Robust standard deviation `1.4826 × median |r|` of residuals.
+fn mad_scale(abs: &mut [f64]) -> f64 {
+    let mid = abs.len() / 2;
+    1.4826 * *abs.select_nth_unstable_by(mid, f64::total_cmp).1
 }
 
 /// Hypotheses needed for `confidence` with inlier ratio `w` and samples of `s` points.
@@ -239,7 +287,7 @@ pub fn fit(kind: Kind, points: &[P3], opts: &Options, r: &Ransac, largest_radius
             kind.name()
         )));
     };
-    let threshold = r.threshold.unwrap_or_else(|| threshold_of(best.scale));
+    let mut threshold = r.threshold.unwrap_or_else(|| threshold_of(best.scale, n));
     let classify =
         |shape: &Shape, t: f64| -> Vec<usize> { (0..n).filter(|&k| residual(shape, &points[k]) <= t).collect() };
     let plain = Options { robust: Robust::None, ..*opts };
@@ -256,6 +304,11 @@ pub fn fit(kind: Kind, points: &[P3], opts: &Options, r: &Ransac, largest_radius
         }
         let subset: Vec<P3> = inliers.iter().map(|&k| points[k]).collect();
         let f = shapes::fit(kind, &subset, &plain)?;
+        if r.threshold.is_none() {
+            // The scale of the inliers' own residuals from their fit.
+            let mut abs: Vec<f64> = subset.iter().map(|x| residual(&f.shape, x)).collect();
+            threshold = threshold_of(mad_scale(&mut abs), n);
+        }
         let next = classify(&f.shape, threshold);
         if next == inliers || rounds == MAX_ROUNDS {
             break f;
@@ -265,7 +318,6 @@ pub fn fit(kind: Kind, points: &[P3], opts: &Options, r: &Ransac, largest_radius
     let mut f = fitted;
     f.largest_residual_index = inliers[f.largest_residual_index];
     let mut abs: Vec<f64> = inliers.iter().map(|&k| residual(&f.shape, &points[k])).collect();
-    abs.sort_by(f64::total_cmp);
     let mut is_inlier = vec![false; n];
     for &k in &inliers {
         is_inlier[k] = true;
@@ -273,7 +325,7 @@ pub fn fit(kind: Kind, points: &[P3], opts: &Options, r: &Ransac, largest_radius
     let outliers: Vec<usize> = (0..n).filter(|&k| !is_inlier[k]).collect();
     f.robust = Some(RobustInfo {
         method: "ransac",
-        scale: 1.4826 * abs[abs.len() / 2],
+        scale: mad_scale(&mut abs),
         downweighted: outliers.len(),
         rounds,
         threshold: Some(threshold),

@@ -448,8 +448,10 @@ fn summarise<const N: usize, P: Problem<N>>(
     (rms, largest, at, params, poor)
 }
 
-/// Sphere: state `(cx, cy, cz, r)`.
-struct SphereProblem;
+/// Sphere: state `(cx, cy, cz, r)`; a radius beyond `largest_radius` has run off.
+struct SphereProblem {
+    largest_radius: f64,
+}
 
 impl Problem<4> for SphereProblem {
     type State = Vector4<f64>;
@@ -467,6 +469,10 @@ impl Problem<4> for SphereProblem {
 
     fn scale(&self, s: &Vector4<f64>) -> f64 {
         s.xyz().norm() + s[3].abs()
+    }
+
+    fn runaway(&self, s: &Vector4<f64>) -> bool {
+        s[3].abs() > self.largest_radius
     }
 }
 
@@ -490,7 +496,8 @@ pub fn algebraic_sphere(points: &[P3], centroid: &P3) -> Option<(P3, f64)> {
 fn fit_sphere(points: &[P3], opts: &Options, spread: &Spread) -> Result<Fit, FitError> {
     let (c, r) = algebraic_sphere(points, &spread.centroid)
         .ok_or_else(|| FitError::Undetermined("the points determine no sphere (algebraic fit is singular)".into()))?;
-    let (sol, robust) = solve(&SphereProblem, Vector4::new(c.x, c.y, c.z, r), points, opts.robust)?;
+    let problem = SphereProblem { largest_radius: DIVERGENCE_FACTOR * spread.sigma[2] };
+    let (sol, robust) = solve(&problem, Vector4::new(c.x, c.y, c.z, r), points, opts.robust)?;
     let s = sol.state;
     if s[3] > DIVERGENCE_FACTOR * spread.sigma[2] || s[3] <= 0.0 {
         return Err(FitError::NotConverged(format!(
@@ -499,7 +506,7 @@ fn fit_sphere(points: &[P3], opts: &Options, spread: &Spread) -> Result<Fit, Fit
         )));
     }
     let (rms, largest, at, params, poor) = summarise(
-        &SphereProblem,
+        &problem,
         &s,
         points,
         ["cx", "cy", "cz", "radius"],
@@ -583,8 +590,11 @@ fn fit_plane(points: &[P3], opts: &Options, spread: &Spread) -> Result<Fit, FitE
     })
 }
 
-/// Circle in its plane's coordinates (points given as `(u, v, 0)`): state `(a, b, r)`.
-struct CircleProblem;
+/// Circle in its plane's coordinates (points given as `(u, v, 0)`): state `(a, b, r)`; a radius
+/// beyond `largest_radius` has run off.
+struct CircleProblem {
+    largest_radius: f64,
+}
 
 impl Problem<3> for CircleProblem {
     type State = SVector<f64, 3>;
@@ -602,6 +612,10 @@ impl Problem<3> for CircleProblem {
 
     fn scale(&self, s: &SVector<f64, 3>) -> f64 {
         s.norm()
+    }
+
+    fn runaway(&self, s: &SVector<f64, 3>) -> bool {
+        s[2].abs() > self.largest_radius
     }
 }
 
@@ -633,7 +647,8 @@ fn fit_circle(points: &[P3], opts: &Options, spread: &Spread) -> Result<Fit, Fit
         .collect();
     let (a, b, r) = algebraic_circle(&local)
         .ok_or_else(|| FitError::Undetermined("the points determine no circle (algebraic fit is singular)".into()))?;
-    let (sol, robust) = solve(&CircleProblem, SVector::<f64, 3>::new(a, b, r), &local, opts.robust)?;
+    let problem = CircleProblem { largest_radius: DIVERGENCE_FACTOR * spread.sigma[2] };
+    let (sol, robust) = solve(&problem, SVector::<f64, 3>::new(a, b, r), &local, opts.robust)?;
     let s = sol.state;
     if s[2] > DIVERGENCE_FACTOR * spread.sigma[2] || s[2] <= 0.0 {
         return Err(FitError::NotConverged(format!(
@@ -642,7 +657,7 @@ fn fit_circle(points: &[P3], opts: &Options, spread: &Spread) -> Result<Fit, Fit
         )));
     }
     let (rms, largest, at, params, poor) =
-        summarise(&CircleProblem, &s, &local, ["centre_u", "centre_v", "radius"], [None, None, Some(s[2])], opts);
+        summarise(&problem, &s, &local, ["centre_u", "centre_v", "radius"], [None, None, Some(s[2])], opts);
     let centre = plane.point + plane.u * s[0] + plane.v * s[1];
     let flat =
         (points.iter().map(|p| plane.n.dot(&(p - plane.point)).powi(2)).sum::<f64>() / points.len() as f64).sqrt();
@@ -662,9 +677,11 @@ fn fit_circle(points: &[P3], opts: &Options, spread: &Spread) -> Result<Fit, Fit
 
 /// Cylinder in Forbes' local parameterisation: the state is a point `o` on the axis, a rotation
 /// `q` whose third column is the axis, and the radius; the local parameters move the axis point
-/// across the axis (`x0, y0`), tilt the axis (`α, β`) and change the radius.
+/// across the axis (`x0, y0`), tilt the axis (`α, β`) and change the radius; a radius beyond
+/// `largest_radius` has run off.
 struct CylinderProblem {
     centroid: P3,
+    largest_radius: f64,
 }
 
 #[derive(Clone, Debug)]
@@ -706,10 +723,14 @@ impl Problem<5> for CylinderProblem {
     fn scale(&self, s: &CylState) -> f64 {
         s.o.coords.norm() + s.r.abs()
     }
+
+    fn runaway(&self, s: &CylState) -> bool {
+        s.r.abs() > self.largest_radius
+    }
 }
 
 fn fit_cylinder(points: &[P3], opts: &Options, spread: &Spread) -> Result<Fit, FitError> {
-    let problem = CylinderProblem { centroid: spread.centroid };
+    let problem = CylinderProblem { centroid: spread.centroid, largest_radius: DIVERGENCE_FACTOR * spread.sigma[2] };
     let mut best: Option<(f64, lsq::Solution<CylState, 5>, Option<RobustInfo>)> = None;
     let mut last_err = None;
     // Start from each principal direction: the axis of a long cylinder is the largest, of a
