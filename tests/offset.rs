@@ -710,3 +710,32 @@ fn far_from_the_origin_the_offset_is_the_same_moved() {
     }
     w.run("medial-trochoid", &["far.csv", "--radius", "5"], b"").ok();
 }
+
+/// A DXF drawing (an LWPOLYLINE with a bulge and a CIRCLE island) is offset and pocketed exactly
+/// as the same contours written as the table are (the output byte for byte); its other entities
+/// are named in one warning.
+#[test]
+fn a_dxf_drawing_offsets_like_its_table() {
+    let w = Work::new();
+    let dxf = "0\nSECTION\n2\nENTITIES\n\
+               0\nLWPOLYLINE\n8\n0\n90\n4\n70\n1\n10\n0\n20\n0\n10\n40\n20\n0\n42\n1\n10\n40\n20\n30\n10\n0\n20\n30\n\
+               0\nCIRCLE\n8\n0\n10\n15\n20\n15\n30\n0\n40\n5\n\
+               0\nTEXT\n8\n0\n10\n0\n20\n0\n1\nnote\n\
+               0\nENDSEC\n0\nEOF\n";
+    w.write("pocket.dxf", dxf);
+    w.write(
+        "pocket.csv",
+        "path,move,x,y,z,xc,yc\n1,line,0,0,0,,\n1,line,40,0,0,,\n1,ccw,40,30,0,40,15\n1,line,0,30,0,,\n1,line,0,0,0,,\n\
+         2,line,20,15,0,,\n2,ccw,10,15,0,15,15\n2,ccw,20,15,0,15,15\n",
+    );
+    for args in [&["--radius", "2", "--side", "left"][..], &["--radius", "2", "--until-empty"][..]] {
+        let table = w.run(BIN, &[&["pocket.csv"], args].concat(), b"").ok();
+        let drawing = w.run(BIN, &[&["pocket.dxf"], args].concat(), b"");
+        assert_eq!(drawing.ok(), table, "{args:?}");
+        assert!(
+            drawing.stderr.contains("1 entities that are not contours skipped (the first: TEXT"),
+            "{}",
+            drawing.stderr
+        );
+    }
+}

@@ -193,7 +193,15 @@ fn run(args: Args) -> Result<()> {
         }
         camkit::gcode::program_to_table(&camkit::gcode::read(&input.name, text)?).0
     } else {
-        table::read(&input, &[Col::X, Col::Y])?
+        let (table, skipped) = camkit::contour::load::table(&input)?;
+        if let Some((kind, line)) = skipped.first() {
+            cli::warn(&format!(
+                "{}: {} entities that are not contours skipped (the first: {kind} at line {line})",
+                input.name,
+                skipped.len()
+            ));
+        }
+        table
     };
     if table.rows.is_empty() {
         return Err(Error::input("no rows: nothing to offset").at(Location::file(&input.name)));
