@@ -78,6 +78,69 @@ impl Program {
         }
     }
 
+    /// Makes every chain continuous: a move that does not start where the one before it ends
+    /// (and starts no chain) would be joined on the machine by a straight feed move the plan
+    /// never checked. A link is re-made from the end before it if that keeps `wall` mm from
+    /// every loop of `regions`, else dropped and its next move starts a chain (a retract); a
+    /// cutting move gets such a link, or starts a chain. Returns how many moves became retracts.
+    pub fn mend(&mut self, regions: &[Region], wall: f64) -> usize {
+        let clear = |s: &Seg| {
+            regions.iter().map(|r| clearance(s, r)).fold(f64::INFINITY, f64::min) >= wall - camkit::tol::OFFSET_TOL
+        };
+        let mut out: Vec<Move> = Vec::with_capacity(self.moves.len());
+        let mut retracts = 0;
+        let mut pending_retract = false;
+        for mut m in self.moves.drain(..) {
+            m.retract_before |= pending_retract;
+            pending_retract = false;
+            let Some(end) = out.last().map(|p| p.seg.end()) else {
+                out.push(m);
+                continue;
+            };
+            if m.retract_before || (m.seg.start() - end).norm() <= camkit::tol::POINT_EPS {
+                out.push(m);
+                continue;
+            }
+            if m.tag == Tag::Link {
+                let link = Seg::Line(end, m.seg.end());
+                if link.length() > camkit::tol::POINT_EPS && clear(&link) {
+                    out.push(Move { seg: link, ..m });
+                } else if link.length() > camkit::tol::POINT_EPS {
+                    pending_retract = true;
+                    retracts += 1;
+                }
+                continue;
+            }
+            let link = Seg::Line(end, m.seg.start());
+            if clear(&link) {
+                out.push(Move { seg: link, tag: Tag::Link, retract_before: false });
+            } else {
+                m.retract_before = true;
+                retracts += 1;
+            }
+            out.push(m);
+        }
+        self.moves = out;
+        retracts
+    }
+
+    /// The program with the link at `i` dropped and the move after it starting a chain (a
+    /// retract and a plunge instead of the feed move).
+    pub fn retract_link(&mut self, i: usize) {
+        debug_assert_eq!(self.moves[i].tag, Tag::Link);
+        self.moves.remove(i);
+        if let Some(m) = self.moves.get_mut(i) {
+            m.retract_before = true;
+        }
+    }
+
+    /// True if every move starts where the one before it ends or starts a chain.
+    pub fn continuous(&self) -> bool {
+        self.moves
+            .windows(2)
+            .all(|w| w[1].retract_before || (w[1].seg.start() - w[0].seg.end()).norm() <= camkit::tol::POINT_EPS)
+    }
+
     /// Where the last move ends.
     pub fn end(&self) -> Option<P2> {
         self.moves.last().map(|m| m.seg.end())
