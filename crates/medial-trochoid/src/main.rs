@@ -584,7 +584,6 @@ fn analyse_given(
         write_atomic(svg, plot::given_plot(&title, regions, &a).to_svg(1000.0).as_bytes())?;
     }
     if let Some(report) = &args.io.report {
-        let roundoff = medial_trochoid::ENGAGEMENT_ROUNDOFF_DEG;
         let mut rep = Report::new("medial-trochoid");
         rep.set("program", "given")
             .set("analysed", name.as_str())
@@ -601,7 +600,7 @@ fn analyse_given(
             .set("entry_engagement_deg", a.max_entry)
             .set("samples_over_threshold", a.over)
             .set("link_samples_over_threshold", a.over_links)
-            .set("threshold_held", a.max_cutting <= s.threshold + roundoff)
+            .set("threshold_held", a.over + a.over_links == 0)
             .set("length_mm", a.program.moves.iter().map(|m| m.seg.length()).sum::<f64>())
             .set("entry_length_mm", a.program.length(Tag::Entry))
             .set("air_length_mm", given.air_length)
