@@ -7,12 +7,13 @@ pocket is kept in --keep DIR (default /tmp/fuzz-trochoid-kept).
 
   scripts/fuzz-trochoid.py [SEEDS] [--family star|rect|slot|sharp|all] [--first N] [--jobs J] [--keep DIR]
                           [--minutes M]   (no pocket is started after M minutes; the summary covers those run)
+                          [--radii 2,3,5] (the tool radii each pocket runs at)
                                   (binary: $TROCHOID or $CARGO_TARGET_DIR/release/medial-trochoid)
 
 Families: star (stars of lines and arcs, radii 15-24 mm, 0-2 round islands), rect (unions of grid cells, x-monotone,
 some with a rectangular island), slot (thin L and U slots, straight or round ends, width 2R x
 0.9-1.4 for an R of the runs), sharp (polygons with spikes of 4-25 degree inside corners).
-Settings: R 2, 3, 5 (each pocket runs every R once with a random threshold 40/30, step default or
+Settings: R 2, 3, 5 or --radii (each pocket runs every R once with a random threshold 40/30, step default or
 0.6 R, allowance 0 or 0.3) and one run with --layers 2 --layer-depth 5.
 Checks of each exit-0 run (the written rows, every layer): the tool centre of every row (and the
 middle of every arc row) at least R + allowance - 1e-6 from the input walls (exact point-segment and
@@ -255,11 +256,11 @@ def reread(text):
 
 # ---------------------------------------------------------------- one run and its checks
 
-def settings(rnd):
+def settings(rnd, radii=(2, 3, 5)):
     runs = []
-    for R in (2, 3, 5):
+    for R in radii:
         runs.append((R, rnd.choice([40, 30]), rnd.choice([None, 0.6 * R]), rnd.choice([0, 0.3]), 1))
-    R = rnd.choice([2, 3, 5])
+    R = rnd.choice(list(radii))
     runs.append((R, rnd.choice([40, 30]), rnd.choice([None, 0.6 * R]), rnd.choice([0, 0.3]), 2))
     return runs
 
@@ -378,7 +379,7 @@ def main():
     argv = sys.argv[1:]
     opt = lambda k, d: argv[argv.index(k) + 1] if k in argv else d
     pos = [a for i, a in enumerate(argv) if not a.startswith("--") and (i == 0 or argv[i - 1] not in
-                                                                         ("--family", "--first", "--jobs", "--keep", "--minutes"))]
+                                                                         ("--family", "--first", "--jobs", "--keep", "--minutes", "--radii"))]
     seeds = int(pos[0]) if pos else 40
     fam = opt("--family", "all")
     first = int(opt("--first", "1"))
@@ -386,6 +387,7 @@ def main():
     keep = opt("--keep", "/tmp/fuzz-trochoid-kept")
     deadline = time.time() + 60 * float(opt("--minutes", "1e9"))
     fams = list(FAMILIES) if fam == "all" else [fam]
+    radii = tuple(float(r) if "." in r else int(r) for r in opt("--radii", "2,3,5").split(","))
     counts, kept = {"exit0": 0, "exit2": 0, "defect": 0}, []
     stats = {"shortfall": -1e9, "on_loop": 0.0, "uncut_runs": 0, "analysed": 0, "link_deg": 0.0, "largest_deg": 0.0}
     per_family = {f: [0, 0, 0] for f in fams}
@@ -405,7 +407,7 @@ def main():
             fh.write(text)
         loops = reread(text)
         res = []
-        for k, run in enumerate(settings(rnd)):
+        for k, run in enumerate(settings(rnd, radii)):
             code, err, args, out, repf = one(BIN, src, loops, run, tmp, f"{f}-{seed}-{k}")
             why = None
             if code == 0:

@@ -688,6 +688,7 @@ fn build(
         let p = retracted(&trochoidal.program, &over, s.radius, &mut relinks);
         trochoidal = analyse_after(p, s, walls, &trochoidal, first);
     }
+    debug_assert!(trochoidal.program.continuous(), "a chain of the program jumps");
     Built { passes, rests, trochoidal, relinks }
 }
 

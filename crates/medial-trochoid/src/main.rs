@@ -100,7 +100,8 @@ struct Args {
     /// threshold: a disk of that radius rolled inside it rounds its inside corners and drops
     /// gaps narrower than twice the radius; both programs are made in the opened pocket, the
     /// gouge check stays against the given walls, and the material left is named in the report
-    /// (uncut, uncut_radius_mm, uncut_area_mm2) and in a warning.
+    /// (uncut, uncut_radius_mm, uncut_area_mm2; apart from unreachable_area_mm2, what no tool of
+    /// radius R + allowance reaches at all) and in a warning.
     #[arg(long)]
     no_leave_uncut: bool,
     /// Snap grid of the Voronoi input (mm).
@@ -133,7 +134,9 @@ struct Args {
     /// Time with the chip-thickness limit alone (no force limit).
     #[arg(long, conflicts_with = "force_at")]
     no_force_limit: bool,
-    /// Decimals of written positions (exact by default).
+    /// Decimals of written positions (exact by default). The plan keeps 1.5·√2·10^-N mm more
+    /// from the walls and is made under the threshold by what that rounding may add, so that the
+    /// written rows keep R + allowance and the threshold (the report is the written program's).
     #[arg(long, value_name = "N")]
     decimals: Option<u32>,
     /// SVG of the written program: contours, medial axis, danger regions, passes coloured by engagement.
@@ -169,7 +172,10 @@ fn after_help() -> String {
         "Material the tool cannot reach under the threshold is left uncut (see --no-leave-uncut): report keys uncut\n",
     );
     s.push_str(
-        "(per stretch: loop = path id, from, to, length_mm, thickness_mm, thickest_at), uncut_radius_mm, uncut_area_mm2.\n",
+        "(per stretch: loop = path id, from, to, length_mm, thickness_mm, thickest_at), uncut_radius_mm, uncut_area_mm2;\n",
+    );
+    s.push_str(
+        "unreachable_area_mm2 is what no tool of radius R + allowance reaches at all (corner fillets, acute tips).\n",
     );
     s.push_str("\nExit status: 0 done, 1 a check failed, 2 bad input or usage.");
     s

@@ -161,3 +161,42 @@ pub fn clearance(s: &Seg, region: &Region) -> f64 {
 pub fn point_clearance(p: &P2, region: &Region) -> f64 {
     region.loops().iter().flat_map(|c| c.segs()).map(|b| b.distance_to(p)).fold(f64::INFINITY, f64::min)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_link_that_no_longer_starts_where_its_pass_ends_is_made_again_or_retracted() {
+        // A 40 × 20 pocket; a pass ending at (10, 10), then a link that starts at (30, 10).
+        let outer =
+            Contour::polygon(&[P2::new(0.0, 0.0), P2::new(40.0, 0.0), P2::new(40.0, 20.0), P2::new(0.0, 20.0)], true);
+        let region = Region { outer, islands: Vec::new(), outer_source: 0, island_sources: Vec::new() };
+        let mv = |a: (f64, f64), b: (f64, f64), tag: Tag| Move {
+            seg: Seg::Line(P2::new(a.0, a.1), P2::new(b.0, b.1)),
+            tag,
+            retract_before: false,
+        };
+        let program = |link_to: (f64, f64)| Program {
+            moves: vec![
+                Move { retract_before: true, ..mv((5.0, 10.0), (10.0, 10.0), Tag::Contour) },
+                mv((30.0, 10.0), link_to, Tag::Link),
+                mv(link_to, (link_to.0, 15.0), Tag::Contour),
+            ],
+        };
+        // Clear of the walls by 5: the link is made from (10, 10).
+        let mut p = program((30.0, 12.0));
+        assert!(!p.continuous());
+        assert_eq!(p.mend(std::slice::from_ref(&region), 5.0), 0);
+        assert!(p.continuous());
+        assert_eq!(p.moves[1].seg, Seg::Line(P2::new(10.0, 10.0), P2::new(30.0, 12.0)));
+        assert_eq!(p.moves.len(), 3);
+        // A wall distance of 9.5, which the straight move from (10, 10) breaks (its end is 8
+        // from the wall y = 20): dropped, the pass after it starts a chain.
+        let mut p = program((30.0, 12.0));
+        assert_eq!(p.mend(&[region], 9.5), 1);
+        assert!(p.continuous());
+        assert_eq!(p.moves.len(), 2);
+        assert!(p.moves[1].retract_before && p.moves[1].tag == Tag::Contour);
+    }
+}
