@@ -354,7 +354,9 @@ def agree(binary, src, run, out, rep, stats):
     stats["analysed"] += 1
     stats["link_deg"] = max(stats["link_deg"], given["link_engagement_deg"])
     stats["largest_deg"] = max(stats["largest_deg"], given["largest_engagement_deg"])
-    return [f"--analyse {k} {given.get(k)} vs the report's {rep.get(k)}" for k in AGREE if given.get(k) != rep.get(k)]
+    fails = [f"--analyse {k} {given.get(k)} vs the report's {rep.get(k)}" for k in AGREE if given.get(k) != rep.get(k)]
+    stats["agreed"] += not fails
+    return fails
 
 
 def one(binary, src, loops, run, tmp, tag):
@@ -389,7 +391,7 @@ def main():
     fams = list(FAMILIES) if fam == "all" else [fam]
     radii = tuple(float(r) if "." in r else int(r) for r in opt("--radii", "2,3,5").split(","))
     counts, kept = {"exit0": 0, "exit2": 0, "defect": 0}, []
-    stats = {"shortfall": -1e9, "on_loop": 0.0, "uncut_runs": 0, "analysed": 0, "link_deg": 0.0, "largest_deg": 0.0}
+    stats = {"shortfall": -1e9, "on_loop": 0.0, "uncut_runs": 0, "analysed": 0, "agreed": 0, "link_deg": 0.0, "largest_deg": 0.0}
     per_family = {f: [0, 0, 0] for f in fams}
     causes = {"exit 1, --step side-cuts over the threshold": 0, "exit 1, other": 0, "other": 0}
     os.makedirs(keep, exist_ok=True)
@@ -461,7 +463,8 @@ def main():
     print("per family (exit0, exit2, defect): " + ", ".join(f"{f} {v}" for f, v in per_family.items()))
     print(f"largest wall-clearance shortfall (R + allowance - distance, negative = clear): {stats['shortfall']:.3g} mm;"
           f" uncut from/to off their loop by at most {stats['on_loop']:.3g} mm over {stats['uncut_runs']} runs leaving uncut")
-    print(f"--analyse of {stats['analysed']} written programs agreed with their reports on {', '.join(AGREE)};"
+    print(f"--analyse of {stats['agreed']} of {stats['analysed']} written programs (those that passed the checks above)"
+          f" agreed with their reports on {', '.join(AGREE)};"
           f" largest engagement analysed {stats['largest_deg']:.6f} deg, on links {stats['link_deg']:.6f} deg")
     sys.exit(1 if kept else 0)
 
