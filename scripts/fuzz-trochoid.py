@@ -7,19 +7,23 @@ pocket is kept in --keep DIR (default /tmp/fuzz-trochoid-kept).
 
   scripts/fuzz-trochoid.py [SEEDS] [--family star|rect|slot|sharp|all] [--first N] [--jobs J] [--keep DIR]
                           [--minutes M]   (no pocket is started after M minutes; the summary covers those run)
+                          [--radii 2,3,5] (the tool radii each pocket runs at)
                                   (binary: $TROCHOID or $CARGO_TARGET_DIR/release/medial-trochoid)
 
 Families: star (stars of lines and arcs, radii 15-24 mm, 0-2 round islands), rect (unions of grid cells, x-monotone,
 some with a rectangular island), slot (thin L and U slots, straight or round ends, width 2R x
 0.9-1.4 for an R of the runs), sharp (polygons with spikes of 4-25 degree inside corners).
-Settings: R 2, 3, 5 (each pocket runs every R once with a random threshold 40/30, step default or
+Settings: R 2, 3, 5 or --radii (each pocket runs every R once with a random threshold 40/30, step default or
 0.6 R, allowance 0 or 0.3) and one run with --layers 2 --layer-depth 5.
 Checks of each exit-0 run (the written rows, every layer): the tool centre of every row (and the
 middle of every arc row) at least R + allowance - 1e-6 from the input walls (exact point-segment and
 point-arc distances, islands included) and inside the pocket; the report's largest_engagement_deg
 <= threshold + 1e-5, threshold_held true, no_gouge true; the engagement column <= threshold + 1e-5
-on trochoid and contour rows; every uncut stretch's from/to on the loop it names (1e-6 mm) and
-0 <= uncut_area_mm2 < the pocket's area.
+on trochoid and contour rows; every straight move (from the row before) R + allowance - 1e-6 or
+more from the walls along its whole length (links across the pocket included); every uncut
+stretch's from/to on the loop it names (1e-6 mm) and 0 <= uncut_area_mm2 < the pocket's area; and
+`--analyse` of the written program gives the report's figures of it exactly (engagement of cuts,
+links and entries, samples over the threshold, clearance, no_gouge, threshold_held).
 """
 import csv, json, math, os, random, re, shutil, subprocess, sys, tempfile, time
 from concurrent.futures import ThreadPoolExecutor
@@ -54,6 +58,19 @@ def arc_dist(p, a, b, c, ccw):
 def piece_dist(p, piece):
     a, b, c, ccw = piece
     return seg_dist(p, a, b) if c is None else arc_dist(p, a, b, c, ccw)
+
+
+def move_dist(p, q, piece):
+    """Distance from the straight move p -> q to a wall piece: exact for a line (segments that
+    do not cross are nearest at an end of one), the move sampled every 0.05 mm for an arc."""
+    a, b, c, _ = piece
+    if c is None:
+        cross = lambda u, v, w: (v[0] - u[0]) * (w[1] - u[1]) - (v[1] - u[1]) * (w[0] - u[0])
+        if cross(p, q, a) * cross(p, q, b) < 0 and cross(a, b, p) * cross(a, b, q) < 0:
+            return 0.0
+        return min(seg_dist(p, a, b), seg_dist(q, a, b), seg_dist(a, p, q), seg_dist(b, p, q))
+    n = max(1, int(math.ceil(math.dist(p, q) / 0.05)))
+    return min(piece_dist((p[0] + (q[0] - p[0]) * k / n, p[1] + (q[1] - p[1]) * k / n), piece) for k in range(n + 1))
 
 
 def flatten(loop, sag=1e-3):
@@ -239,11 +256,11 @@ def reread(text):
 
 # ---------------------------------------------------------------- one run and its checks
 
-def settings(rnd):
+def settings(rnd, radii=(2, 3, 5)):
     runs = []
-    for R in (2, 3, 5):
+    for R in radii:
         runs.append((R, rnd.choice([40, 30]), rnd.choice([None, 0.6 * R]), rnd.choice([0, 0.3]), 1))
-    R = rnd.choice([2, 3, 5])
+    R = rnd.choice(list(radii))
     runs.append((R, rnd.choice([40, 30]), rnd.choice([None, 0.6 * R]), rnd.choice([0, 0.3]), 2))
     return runs
 
@@ -273,6 +290,12 @@ def check(loops, run, out_csv, rep, stats):
         fails.append(f"{len(zs)} cutting z levels for {layers} layers")
     for r in rows:
         p = (float(r["x"]), float(r["y"]))
+        if r["move"] == "line" and prev is not None:
+            # The whole move keeps the wall distance (a link across the pocket, not only its ends).
+            d = min(move_dist(prev, p, pc) for pc in pieces)
+            worst_short = max(worst_short, wall - d)
+            if d < wall - CLEAR_TOL:
+                fails.append(f"line {rows.index(r) + 2} {r['tag']} move from {prev}: {d:.9f} mm from the walls < {wall}")
         pts = [p]
         if r["move"] in ("cw", "ccw") and prev is not None:
             c = (float(r["xc"]), float(r["yc"]))
@@ -312,6 +335,30 @@ def check(loops, run, out_csv, rep, stats):
     return fails[:5]
 
 
+# Figures of the written program that its own --analyse must give exactly as the plan's report.
+AGREE = ["largest_engagement_deg", "link_engagement_deg", "entry_engagement_deg", "smallest_wall_clearance_mm",
+         "no_gouge", "threshold_held", "samples_over_threshold", "link_samples_over_threshold", "samples"]
+
+
+def agree(binary, src, run, out, rep, stats):
+    """--analyse of the written program against the plan's report: a list of disagreements."""
+    R, thr, _, allow, _ = run
+    an = out + ".an.json"
+    p = subprocess.run([binary, src, "--radius", str(R), "--threshold", str(thr), "--allowance", str(allow),
+                        "--analyse", out, "--report", an, "-o", os.devnull], capture_output=True, text=True)
+    if p.returncode != 0:
+        return [f"--analyse exit {p.returncode}: {p.stderr.strip()[-200:]}"]
+    with open(an) as fh:
+        given = json.load(fh)
+    os.remove(an)
+    stats["analysed"] += 1
+    stats["link_deg"] = max(stats["link_deg"], given["link_engagement_deg"])
+    stats["largest_deg"] = max(stats["largest_deg"], given["largest_engagement_deg"])
+    fails = [f"--analyse {k} {given.get(k)} vs the report's {rep.get(k)}" for k in AGREE if given.get(k) != rep.get(k)]
+    stats["agreed"] += not fails
+    return fails
+
+
 def one(binary, src, loops, run, tmp, tag):
     R, thr, step, allow, layers = run
     out, repf = os.path.join(tmp, f"{tag}.csv"), os.path.join(tmp, f"{tag}.json")
@@ -334,7 +381,7 @@ def main():
     argv = sys.argv[1:]
     opt = lambda k, d: argv[argv.index(k) + 1] if k in argv else d
     pos = [a for i, a in enumerate(argv) if not a.startswith("--") and (i == 0 or argv[i - 1] not in
-                                                                         ("--family", "--first", "--jobs", "--keep", "--minutes"))]
+                                                                         ("--family", "--first", "--jobs", "--keep", "--minutes", "--radii"))]
     seeds = int(pos[0]) if pos else 40
     fam = opt("--family", "all")
     first = int(opt("--first", "1"))
@@ -342,8 +389,9 @@ def main():
     keep = opt("--keep", "/tmp/fuzz-trochoid-kept")
     deadline = time.time() + 60 * float(opt("--minutes", "1e9"))
     fams = list(FAMILIES) if fam == "all" else [fam]
+    radii = tuple(float(r) if "." in r else int(r) for r in opt("--radii", "2,3,5").split(","))
     counts, kept = {"exit0": 0, "exit2": 0, "defect": 0}, []
-    stats = {"shortfall": -1e9, "on_loop": 0.0, "uncut_runs": 0}
+    stats = {"shortfall": -1e9, "on_loop": 0.0, "uncut_runs": 0, "analysed": 0, "agreed": 0, "link_deg": 0.0, "largest_deg": 0.0}
     per_family = {f: [0, 0, 0] for f in fams}
     causes = {"exit 1, --step side-cuts over the threshold": 0, "exit 1, other": 0, "other": 0}
     os.makedirs(keep, exist_ok=True)
@@ -361,14 +409,14 @@ def main():
             fh.write(text)
         loops = reread(text)
         res = []
-        for k, run in enumerate(settings(rnd)):
+        for k, run in enumerate(settings(rnd, radii)):
             code, err, args, out, repf = one(BIN, src, loops, run, tmp, f"{f}-{seed}-{k}")
             why = None
             if code == 0:
                 try:
                     with open(repf) as fh:
                         rep = json.load(fh)
-                    fails = check(loops, run, out, rep, stats)
+                    fails = check(loops, run, out, rep, stats) or agree(BIN, src, run, out, rep, stats)
                 except Exception as e:  # a missing or unreadable output is a defect too
                     fails = [f"unreadable output: {e!r}"]
                 why = "; ".join(fails) if fails else None
@@ -415,6 +463,9 @@ def main():
     print("per family (exit0, exit2, defect): " + ", ".join(f"{f} {v}" for f, v in per_family.items()))
     print(f"largest wall-clearance shortfall (R + allowance - distance, negative = clear): {stats['shortfall']:.3g} mm;"
           f" uncut from/to off their loop by at most {stats['on_loop']:.3g} mm over {stats['uncut_runs']} runs leaving uncut")
+    print(f"--analyse of {stats['agreed']} of {stats['analysed']} written programs (those that passed the checks above)"
+          f" agreed with their reports on {', '.join(AGREE)};"
+          f" largest engagement analysed {stats['largest_deg']:.6f} deg, on links {stats['link_deg']:.6f} deg")
     sys.exit(1 if kept else 0)
 
 

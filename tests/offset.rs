@@ -739,3 +739,35 @@ fn a_dxf_drawing_offsets_like_its_table() {
         );
     }
 }
+
+#[test]
+fn a_pocket_exactly_2r_wide_is_cut_along_its_centre_line() {
+    // A 50 × 5 slot: at R = 2.5 (and a hair under) the region offset is a loop of zero width,
+    // which pocket mode used to drop ("does not fit") while contour mode cut the centre line.
+    let w = Work::new();
+    let slot = pts(&[(0.0, 0.0), (50.0, 0.0), (50.0, 5.0), (0.0, 5.0)]);
+    w.write("slot.csv", format!("{HEAD}{}", polygon_csv(0, &slot)));
+    for r in ["2.5", "2.4999999"] {
+        let run = w.run(BIN, &["slot.csv", "--radius", r, "--until-empty", "--report", "r.json", "-o", "p.csv"], b"");
+        run.ok();
+        assert!(!run.stderr.contains("does not fit"), "{}", run.stderr);
+        let rep = report(&w, "r.json");
+        assert_eq!(rep["passes"], 1, "{rep}");
+        assert_eq!(rep["centre_line_passes"], 1, "{rep}");
+        let ps = paths(&w.read("p.csv"));
+        assert_eq!(ps.len(), 1);
+        let radius: f64 = r.parse().unwrap();
+        let pts = samples(&ps[0]);
+        // Along the centre line from end to end, every point R or more from the walls.
+        let xs = pts.iter().map(|p| p.x).fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| (a.min(x), b.max(x)));
+        assert!((xs.0 - radius).abs() <= TOL && (xs.1 - (50.0 - radius)).abs() <= TOL, "{xs:?}");
+        for p in pts {
+            assert!((p.y - radius).abs() <= TOL, "{p}");
+            assert!(polygon_distance(&p, &slot) >= radius - TOL, "{p}");
+        }
+    }
+    // Wider than the slot: still nothing to cut.
+    let run = w.run(BIN, &["slot.csv", "--radius", "2.6", "--until-empty", "-o", "n.csv"], b"");
+    run.ok();
+    assert!(run.stderr.contains("does not fit"), "{}", run.stderr);
+}

@@ -663,27 +663,62 @@ fn build(
         None => analyse(troch, s, walls),
     };
     // Links over the threshold: their passes started on cleared ground instead (one link a
-    // round, re-simulated each time; a second round on the same link makes it a retract).
+    // round, re-simulated each time; a second round on the same link makes it a retract, and so
+    // does a link into an open pass, or one still over when the rounds run out).
     let mut relinks = Vec::new();
     for _ in 0..RELINK_ROUNDS {
-        let limit = s.threshold + ENGAGEMENT_ROUNDOFF_DEG;
-        let Some(i) = trochoidal
-            .samples
-            .iter()
-            .zip(&trochoidal.engagement)
-            .find(|((i, _), e)| trochoidal.program.moves[*i].tag == Tag::Link && **e > limit)
-            .map(|((i, _), _)| *i)
-        else {
+        let Some(&i) = links_over(&trochoidal, s.threshold).first() else {
             break;
         };
-        let Some((p, how)) = relink::relink(&trochoidal.program, i, s.radius, wall, s.sample, regions) else {
-            break;
+        let p = match relink::relink(&trochoidal.program, i, s.radius, wall, s.sample, regions) {
+            Some((p, how)) => {
+                relinks.push(how);
+                p
+            }
+            None => retracted(&trochoidal.program, &[i], s.radius, &mut relinks),
         };
-        relinks.push(how);
         // The moves before the link are the same: their engagement is reused.
         trochoidal = analyse_after(p, s, walls, &trochoidal, i);
     }
+    // Links still over the threshold when the rounds ran out: retracts (again while a link
+    // meets material a dropped one no longer cuts; each round drops one link or more).
+    loop {
+        let over = links_over(&trochoidal, s.threshold);
+        let Some(&first) = over.first() else { break };
+        let p = retracted(&trochoidal.program, &over, s.radius, &mut relinks);
+        trochoidal = analyse_after(p, s, walls, &trochoidal, first);
+    }
+    debug_assert!(trochoidal.program.continuous(), "a chain of the program jumps");
     Built { passes, rests, trochoidal, relinks }
+}
+
+/// Indices of the links of `a` with a sample over `threshold` beyond round-off, in order.
+fn links_over(a: &Analysed, threshold: f64) -> Vec<usize> {
+    let mut out: Vec<usize> = a
+        .samples
+        .iter()
+        .zip(&a.engagement)
+        .filter(|((i, _), e)| a.program.moves[*i].tag == Tag::Link && **e > threshold + ENGAGEMENT_ROUNDOFF_DEG)
+        .map(|((i, _), _)| *i)
+        .collect();
+    out.dedup();
+    out
+}
+
+/// `p` with the links at `links` (indices, increasing) made retracts, each noted in `relinks`
+/// (the plunge at the next move's start, with the engagement of a tool of radius `r` standing
+/// there after everything cut before).
+fn retracted(p: &Program, links: &[usize], r: f64, relinks: &mut Vec<relink::Relink>) -> Program {
+    let mut q = p.clone();
+    let cut = Cut::new(r, p.moves.iter().map(|m| m.seg).collect());
+    for &i in links {
+        let at = p.moves.get(i + 1).map_or(p.moves[i].seg.end(), |m| m.seg.start());
+        relinks.push(relink::Relink { at, standing_deg: cut.engagement_at(&at, i).to_degrees(), retract: true });
+    }
+    for &i in links.iter().rev() {
+        q.retract_link(i);
+    }
+    q
 }
 
 /// Samples (piece, fraction) of cutting moves (trochoids and passes) whose engagement is over

@@ -16,7 +16,7 @@ use clap::{Parser, ValueEnum};
 use medial_trochoid::feed::FeedModel;
 use medial_trochoid::medial::MedialOptions;
 use medial_trochoid::program::Tag;
-use medial_trochoid::{Analysed, Settings, plan, plan_leaving_uncut, plot};
+use medial_trochoid::{Analysed, ENGAGEMENT_ROUNDOFF_DEG, Settings, plan, plan_leaving_uncut, plot};
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Instant;
@@ -100,7 +100,8 @@ struct Args {
     /// threshold: a disk of that radius rolled inside it rounds its inside corners and drops
     /// gaps narrower than twice the radius; both programs are made in the opened pocket, the
     /// gouge check stays against the given walls, and the material left is named in the report
-    /// (uncut, uncut_radius_mm, uncut_area_mm2) and in a warning.
+    /// (uncut, uncut_radius_mm, uncut_area_mm2; apart from unreachable_area_mm2, what no tool of
+    /// radius R + allowance reaches at all) and in a warning.
     #[arg(long)]
     no_leave_uncut: bool,
     /// Snap grid of the Voronoi input (mm).
@@ -133,7 +134,9 @@ struct Args {
     /// Time with the chip-thickness limit alone (no force limit).
     #[arg(long, conflicts_with = "force_at")]
     no_force_limit: bool,
-    /// Decimals of written positions (exact by default).
+    /// Decimals of written positions (exact by default). The plan keeps 1.5·√2·10^-N mm more
+    /// from the walls and is made under the threshold by what that rounding may add, so that the
+    /// written rows keep R + allowance and the threshold (the report is the written program's).
     #[arg(long, value_name = "N")]
     decimals: Option<u32>,
     /// SVG of the written program: contours, medial axis, danger regions, passes coloured by engagement.
@@ -169,7 +172,10 @@ fn after_help() -> String {
         "Material the tool cannot reach under the threshold is left uncut (see --no-leave-uncut): report keys uncut\n",
     );
     s.push_str(
-        "(per stretch: loop = path id, from, to, length_mm, thickness_mm, thickest_at), uncut_radius_mm, uncut_area_mm2.\n",
+        "(per stretch: loop = path id, from, to, length_mm, thickness_mm, thickest_at), uncut_radius_mm, uncut_area_mm2;\n",
+    );
+    s.push_str(
+        "unreachable_area_mm2 is what no tool of radius R + allowance reaches at all (corner fillets, acute tips).\n",
     );
     s.push_str("\nExit status: 0 done, 1 a check failed, 2 bad input or usage.");
     s
@@ -214,7 +220,21 @@ fn run(args: Args) -> Result<()> {
     if threshold >= 180.0 {
         return Err(Error::input("--threshold must be under 180 degrees"));
     }
-    let step = positive(args.step.unwrap_or(medial_trochoid::default_step(r, threshold)), "--step")?;
+    if args.decimals.is_some_and(|d| d > 12) {
+        return Err(Error::input("--decimals must be at most 12"));
+    }
+    // Planned under the threshold by what rounding to --decimals may add, so that the written
+    // program holds it (checked below on the rounded rows).
+    let slack = rounding_slack_deg(args.decimals, r, threshold);
+    if slack > 0.25 * threshold {
+        return Err(Error::input(format!(
+            "--decimals {} rounds positions by up to {:.3} mm, which may raise the engagement by {slack:.3}°: too coarse for R {r} and a threshold of {threshold}°; write more decimals",
+            args.decimals.unwrap_or_default(),
+            rounding_reach(args.decimals)
+        )));
+    }
+    let planned_threshold = threshold - slack;
+    let step = positive(args.step.unwrap_or(medial_trochoid::default_step(r, planned_threshold)), "--step")?;
     let rt = positive(args.trochoid_radius.unwrap_or(0.5 * r), "--trochoid-radius")?;
     if let Some(p) = args.pitch {
         positive(p, "--pitch")?;
@@ -224,9 +244,6 @@ fn run(args: Args) -> Result<()> {
     }
     if !(args.layer_depth.is_finite() && args.layer_depth >= 0.0) || args.layers == Some(0) {
         return Err(Error::input("--layers must be at least 1 and --layer-depth zero or more"));
-    }
-    if args.decimals.is_some_and(|d| d > 12) {
-        return Err(Error::input("--decimals must be at most 12"));
     }
     let settings = Settings {
         radius: r,
@@ -289,7 +306,14 @@ fn run(args: Args) -> Result<()> {
         ));
     }
     let leave_uncut = !(args.no_leave_uncut || args.allow_over_threshold);
-    let planned = if leave_uncut { plan_leaving_uncut(&regions, &settings) } else { plan(&regions, &settings) };
+    // Planned that much farther from the walls that the written program, rounded to
+    // --decimals, still keeps R + allowance; checked below on the rounded rows.
+    let planning = Settings {
+        allowance: settings.allowance + rounding_reach(args.decimals),
+        threshold: planned_threshold,
+        ..settings
+    };
+    let planned = if leave_uncut { plan_leaving_uncut(&regions, &planning) } else { plan(&regions, &planning) };
     let plan = planned.map_err(|e| match e {
         medial_trochoid::PlanError::Pocket(_) => Error::check(e.to_string()),
         // The tool fits no region, or cuts none of it under the threshold: name the first
@@ -304,6 +328,14 @@ fn run(args: Args) -> Result<()> {
     let chosen = if args.program == Which::Trochoid { &plan.trochoidal } else { &plan.offset_only };
     let (z0, layer_count, layer_depth) = layering(job.as_ref(), sources[0].z, args.layers, args.layer_depth)?;
     let out_table = to_table(chosen, z0, layer_count, layer_depth);
+    // The program as written (rounded to --decimals) read back and simulated again: the
+    // report's figures of the written program are this check's, as --analyse gives them.
+    let mut text = Vec::new();
+    table::write(&mut text, &out_table, &WriteOptions { decimals: args.decimals })?;
+    let written = written_check(&text, &name, &regions, &settings)
+        .map_err(|e| Error::check(format!("the written program does not read back: {e}")))?;
+    let w = &written.analysed;
+    let troch_main = args.program == Which::Trochoid;
     if !plan.uncleared.is_empty() {
         cli::warn(&format!(
             "{} dangerous stretches of the medial axis are too narrow for the smallest trochoid loop ({:.3} mm, the given {rt} mm shrunk): left to the passes",
@@ -338,24 +370,48 @@ fn run(args: Args) -> Result<()> {
             p.y
         )
     });
+    // What no tool of radius R reaches at all (the R-opening's rest: acute tips, the inside
+    // corners' fillets) apart from what the threshold strategy leaves.
+    let unreachable = medial_trochoid::uncut::unreachable_area(&regions, r + args.allowance);
+    let uncut_area = plan.uncut.as_ref().map_or(0.0, |u| (u.area - unreachable.unwrap_or(0.0)).max(0.0));
     if let Some(u) = &plan.uncut {
         let thickest = u.stretches.iter().max_by(|a, b| a.thickness.total_cmp(&b.thickness));
         let (t, at) = thickest.map_or((0.0, P2::origin()), |s| (s.thickness, s.thickest_at));
         cli::warn(&format!(
-            "left uncut: {} stretches, {:.3} mm², thickest {t:.3} mm at ({:.3}, {:.3}): the tool cannot reach them under the threshold ({:.3} mm opening); named in the report",
+            "left uncut: {} stretches, {:.3} mm² (besides {:.3} mm² no tool of this radius reaches), thickest {t:.3} mm at ({:.3}, {:.3}): the tool cannot reach them under the threshold ({:.3} mm opening); named in the report",
             u.stretches.len(),
-            u.area,
+            uncut_area,
+            unreachable.unwrap_or(0.0),
             at.x,
             at.y,
             u.rho
         ));
     }
+    // The written program's own figures: cutting moves or links over the threshold fail the
+    // check too.
+    let (written_over, written_links_over) = written.over(threshold);
+    let over = over.or_else(|| {
+        (troch_main && written_over + written_links_over > 0).then(|| {
+            format!(
+                "the program as written has {written_over} cutting and {written_links_over} link samples over the threshold (largest {:.3}° cutting, {:.3}° on links)",
+                w.max_cutting, w.max_link
+            )
+        })
+    });
     let failed = over.as_ref().filter(|_| args.program == Which::Trochoid && !args.allow_over_threshold);
     if let Some(over) = over.as_ref().filter(|_| failed.is_none()) {
         cli::warn(over);
     }
+    let wall_needed = r + args.allowance - camkit::tol::OFFSET_TOL;
+    let gouge = (w.wall_clearance < wall_needed).then(|| {
+        format!(
+            "the program as written comes {:.6} mm from the walls, under R + allowance = {} mm",
+            w.wall_clearance,
+            r + args.allowance
+        )
+    });
     let mut out = Output::new(args.io.output.as_deref());
-    table::write(&mut out, &out_table, &WriteOptions { decimals: args.decimals })?;
+    std::io::Write::write_all(&mut out, &text).map_err(|e| Error::io(e, "output"))?;
     let title = |a: &Analysed, what: &str| {
         format!(
             "{name}: {what}, largest engagement {:.1}° (threshold {threshold}°), {:.2} min per layer",
@@ -367,7 +423,6 @@ fn run(args: Args) -> Result<()> {
     } else {
         (title(&plan.offset_only, "offset passes only"), title(&plan.trochoidal, "trochoids first"))
     };
-    let troch_main = args.program == Which::Trochoid;
     if let Some(path) = &args.svg {
         write_atomic(path, plot::plan_plot(&main_t, &plan, troch_main).to_svg(1000.0).as_bytes())?;
     }
@@ -404,15 +459,16 @@ fn run(args: Args) -> Result<()> {
             .set("trochoid_radius_mm", rt)
             .set("trochoid_radius_range_mm", range(plan.runs.iter().flat_map(|r| r.radii.iter().copied())))
             .set("trochoid_pitch_range_mm", range(plan.runs.iter().flat_map(|r| r.pitches.iter().copied())))
-            .set("offset_only_largest_engagement_deg", a.max_cutting)
-            .set("offset_only_link_engagement_deg", a.max_link)
-            .set("largest_engagement_deg", b.max_cutting)
-            .set("link_engagement_deg", b.max_link)
-            .set("entry_engagement_deg", b.max_entry)
-            .set("threshold_held", b.max_cutting <= threshold + medial_trochoid::ENGAGEMENT_ROUNDOFF_DEG)
-            .set("offset_only_samples_over_threshold", a.over)
-            .set("samples_over_threshold", b.over)
-            .set("link_samples_over_threshold", b.over_links)
+            .set("offset_only_largest_engagement_deg", if troch_main { a.max_cutting } else { w.max_cutting })
+            .set("offset_only_link_engagement_deg", if troch_main { a.max_link } else { w.max_link })
+            .set("largest_engagement_deg", if troch_main { w.max_cutting } else { b.max_cutting })
+            .set("link_engagement_deg", if troch_main { w.max_link } else { b.max_link })
+            .set("entry_engagement_deg", if troch_main { w.max_entry } else { b.max_entry })
+            .set("threshold_held", written_over + written_links_over == 0)
+            .set("planned_threshold_deg", planned_threshold)
+            .set("offset_only_samples_over_threshold", if troch_main { a.over } else { written_over })
+            .set("samples_over_threshold", if troch_main { written_over } else { b.over })
+            .set("link_samples_over_threshold", if troch_main { written_links_over } else { b.over_links })
             .set("repair_rounds", plan.repair_rounds)
             .set("repair_material_points", plan.repair_points)
             .set("over_threshold_at", plan.left_over.iter().map(|(p, e)| vec![p.x, p.y, *e]).collect::<Vec<_>>())
@@ -432,7 +488,8 @@ fn run(args: Args) -> Result<()> {
             )
             .set("uncut_radius_mm", plan.uncut.as_ref().map(|u| u.rho))
             .set("uncut_radii_tried_mm", &plan.openings_tried)
-            .set("uncut_area_mm2", plan.uncut.as_ref().map_or(0.0, |u| u.area))
+            .set("uncut_area_mm2", uncut_area)
+            .set("unreachable_area_mm2", unreachable)
             .set("opened_regions", plan.uncut.as_ref().map(|_| plan.regions.len()))
             .set(
                 "uncut",
@@ -456,9 +513,10 @@ fn run(args: Args) -> Result<()> {
             .set("relinked", plan.relinks.len())
             .set("relinked_by_retract", plan.relinks.iter().filter(|l| l.retract).count())
             .set("relink_standing_engagement_deg", plan.relinks.iter().map(|l| l.standing_deg).collect::<Vec<_>>())
-            .set("samples", b.samples.len())
-            .set("smallest_wall_clearance_mm", b.wall_clearance)
-            .set("no_gouge", b.wall_clearance >= r + args.allowance - camkit::tol::OFFSET_TOL)
+            .set("samples", w.samples.len())
+            .set("smallest_wall_clearance_mm", w.wall_clearance)
+            .set("no_gouge", gouge.is_none())
+            .set("rounding_reach_mm", rounding_reach(args.decimals))
             .set("offset_only_minutes", a.minutes_constant * layers)
             .set("offset_only_variable_feed_minutes", a.minutes * layers)
             .set("trochoidal_minutes", b.minutes * layers)
@@ -490,6 +548,9 @@ fn run(args: Args) -> Result<()> {
             .set("output_rows", out_table.rows.len())
             .set("seconds", started.elapsed().as_secs_f64());
         rep.write(path)?;
+    }
+    if let Some(g) = gouge {
+        return Err(Error::check(format!("the program is not written: {g}")));
     }
     if let Some(over) = failed {
         return Err(Error::check(format!(
@@ -529,7 +590,6 @@ fn analyse_given(
         write_atomic(svg, plot::given_plot(&title, regions, &a).to_svg(1000.0).as_bytes())?;
     }
     if let Some(report) = &args.io.report {
-        let roundoff = medial_trochoid::ENGAGEMENT_ROUNDOFF_DEG;
         let mut rep = Report::new("medial-trochoid");
         rep.set("program", "given")
             .set("analysed", name.as_str())
@@ -546,7 +606,7 @@ fn analyse_given(
             .set("entry_engagement_deg", a.max_entry)
             .set("samples_over_threshold", a.over)
             .set("link_samples_over_threshold", a.over_links)
-            .set("threshold_held", a.max_cutting <= s.threshold + roundoff)
+            .set("threshold_held", a.over + a.over_links == 0)
             .set("length_mm", a.program.moves.iter().map(|m| m.seg.length()).sum::<f64>())
             .set("entry_length_mm", a.program.length(Tag::Entry))
             .set("air_length_mm", given.air_length)
@@ -562,6 +622,52 @@ fn analyse_given(
         rep.write(report)?;
     }
     out.commit()
+}
+
+/// How far (mm) rounding to `decimals` may move a written path: a point by half a unit in x and
+/// in y (√2/2 units), an arc by three times that (its centre moved, its radius taken from its
+/// moved start). Zero when positions are written exactly.
+fn rounding_reach(decimals: Option<u32>) -> f64 {
+    decimals.map_or(0.0, |d| 1.5 * std::f64::consts::SQRT_2 * 10f64.powi(-(d as i32)))
+}
+
+/// How much (degrees) rounding to `decimals` may raise an engagement near the threshold θ: a
+/// side cut's engagement acos(1 − s/R) changes by ds/(R sin θ) with its step over s, which the
+/// rounding of this path and of the one before changes by up to twice [`rounding_reach`]. The
+/// plan is made under the threshold by this much.
+fn rounding_slack_deg(decimals: Option<u32>, r: f64, threshold: f64) -> f64 {
+    let sin = threshold.to_radians().sin().max(0.1);
+    (2.0 * rounding_reach(decimals) / (r * sin)).to_degrees()
+}
+
+/// A written program read back and simulated again.
+struct Written {
+    /// The simulation of the written program's (lowest) layer.
+    analysed: Analysed,
+}
+
+impl Written {
+    /// Samples of cutting moves (trochoids and passes) and of links over `limit` (degrees).
+    fn over(&self, limit: f64) -> (usize, usize) {
+        let a = &self.analysed;
+        let count = |tags: &[Tag]| {
+            a.samples
+                .iter()
+                .zip(&a.engagement)
+                .filter(|((i, _), e)| tags.contains(&a.program.moves[*i].tag) && **e > limit + ENGAGEMENT_ROUNDOFF_DEG)
+                .count()
+        };
+        (count(&[Tag::Trochoid, Tag::Contour]), count(&[Tag::Link]))
+    }
+}
+
+/// The written table `text` read back as `--analyse` reads a given toolpath and simulated in
+/// `regions` (the input's: the gouge check is against its walls).
+fn written_check(text: &[u8], name: &str, regions: &[Region], s: &Settings) -> Result<Written> {
+    let input = Input { name: format!("{name} (the written program)"), data: text.to_vec() };
+    let table = table::read(&input, &[Col::X, Col::Y, Col::Z])?;
+    let given = medial_trochoid::given::read(&table, &input.name)?;
+    Ok(Written { analysed: medial_trochoid::analyse(given.program, s, regions) })
 }
 
 /// Slowest feed of the samples of moves with `tag` (0 if none).

@@ -78,6 +78,69 @@ impl Program {
         }
     }
 
+    /// Makes every chain continuous: a move that does not start where the one before it ends
+    /// (and starts no chain) would be joined on the machine by a straight feed move the plan
+    /// never checked. A link is re-made from the end before it if that keeps `wall` mm from
+    /// every loop of `regions`, else dropped and its next move starts a chain (a retract); a
+    /// cutting move gets such a link, or starts a chain. Returns how many moves became retracts.
+    pub fn mend(&mut self, regions: &[Region], wall: f64) -> usize {
+        let clear = |s: &Seg| {
+            regions.iter().map(|r| clearance(s, r)).fold(f64::INFINITY, f64::min) >= wall - camkit::tol::OFFSET_TOL
+        };
+        let mut out: Vec<Move> = Vec::with_capacity(self.moves.len());
+        let mut retracts = 0;
+        let mut pending_retract = false;
+        for mut m in self.moves.drain(..) {
+            m.retract_before |= pending_retract;
+            pending_retract = false;
+            let Some(end) = out.last().map(|p| p.seg.end()) else {
+                out.push(m);
+                continue;
+            };
+            if m.retract_before || (m.seg.start() - end).norm() <= camkit::tol::POINT_EPS {
+                out.push(m);
+                continue;
+            }
+            if m.tag == Tag::Link {
+                let link = Seg::Line(end, m.seg.end());
+                if link.length() > camkit::tol::POINT_EPS && clear(&link) {
+                    out.push(Move { seg: link, ..m });
+                } else if link.length() > camkit::tol::POINT_EPS {
+                    pending_retract = true;
+                    retracts += 1;
+                }
+                continue;
+            }
+            let link = Seg::Line(end, m.seg.start());
+            if clear(&link) {
+                out.push(Move { seg: link, tag: Tag::Link, retract_before: false });
+            } else {
+                m.retract_before = true;
+                retracts += 1;
+            }
+            out.push(m);
+        }
+        self.moves = out;
+        retracts
+    }
+
+    /// The program with the link at `i` dropped and the move after it starting a chain (a
+    /// retract and a plunge instead of the feed move).
+    pub fn retract_link(&mut self, i: usize) {
+        debug_assert_eq!(self.moves[i].tag, Tag::Link);
+        self.moves.remove(i);
+        if let Some(m) = self.moves.get_mut(i) {
+            m.retract_before = true;
+        }
+    }
+
+    /// True if every move starts where the one before it ends or starts a chain.
+    pub fn continuous(&self) -> bool {
+        self.moves
+            .windows(2)
+            .all(|w| w[1].retract_before || (w[1].seg.start() - w[0].seg.end()).norm() <= camkit::tol::POINT_EPS)
+    }
+
     /// Where the last move ends.
     pub fn end(&self) -> Option<P2> {
         self.moves.last().map(|m| m.seg.end())
@@ -97,4 +160,43 @@ pub fn clearance(s: &Seg, region: &Region) -> f64 {
 /// Distance from `p` to the boundary of `region` (mm), exactly.
 pub fn point_clearance(p: &P2, region: &Region) -> f64 {
     region.loops().iter().flat_map(|c| c.segs()).map(|b| b.distance_to(p)).fold(f64::INFINITY, f64::min)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_link_that_no_longer_starts_where_its_pass_ends_is_made_again_or_retracted() {
+        // A 40 × 20 pocket; a pass ending at (10, 10), then a link that starts at (30, 10).
+        let outer =
+            Contour::polygon(&[P2::new(0.0, 0.0), P2::new(40.0, 0.0), P2::new(40.0, 20.0), P2::new(0.0, 20.0)], true);
+        let region = Region { outer, islands: Vec::new(), outer_source: 0, island_sources: Vec::new() };
+        let mv = |a: (f64, f64), b: (f64, f64), tag: Tag| Move {
+            seg: Seg::Line(P2::new(a.0, a.1), P2::new(b.0, b.1)),
+            tag,
+            retract_before: false,
+        };
+        let program = |link_to: (f64, f64)| Program {
+            moves: vec![
+                Move { retract_before: true, ..mv((5.0, 10.0), (10.0, 10.0), Tag::Contour) },
+                mv((30.0, 10.0), link_to, Tag::Link),
+                mv(link_to, (link_to.0, 15.0), Tag::Contour),
+            ],
+        };
+        // Clear of the walls by 5: the link is made from (10, 10).
+        let mut p = program((30.0, 12.0));
+        assert!(!p.continuous());
+        assert_eq!(p.mend(std::slice::from_ref(&region), 5.0), 0);
+        assert!(p.continuous());
+        assert_eq!(p.moves[1].seg, Seg::Line(P2::new(10.0, 10.0), P2::new(30.0, 12.0)));
+        assert_eq!(p.moves.len(), 3);
+        // A wall distance of 9.5, which the straight move from (10, 10) breaks (its end is 8
+        // from the wall y = 20): dropped, the pass after it starts a chain.
+        let mut p = program((30.0, 12.0));
+        assert_eq!(p.mend(&[region], 9.5), 1);
+        assert!(p.continuous());
+        assert_eq!(p.moves.len(), 2);
+        assert!(p.moves[1].retract_before && p.moves[1].tag == Tag::Contour);
+    }
 }

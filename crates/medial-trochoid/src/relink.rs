@@ -4,7 +4,8 @@
 //! instead where a tool standing there has the least material on its circle (0 where earlier
 //! loops or passes cleared it), and reached by a straight link through the pocket if that keeps
 //! clear of the walls, else by a retract and a plunge there. A link still over the threshold
-//! after that becomes a retract.
+//! after that, or one that does not lead into a closed pass, becomes a retract; so does the link
+//! after the pass if it cannot be made again from the pass's new end ([`Program::mend`]).
 
 use crate::engagement::Cut;
 use crate::program::{Move, Program, Tag, clearance};
@@ -85,7 +86,11 @@ pub fn relink(
     }
     moves.extend(pass);
     moves.extend_from_slice(&p.moves[j1..]);
-    Some((Program { moves }, Relink { at, standing_deg: standing[best].to_degrees(), retract: !safe }))
+    // The pass now ends where it starts, not where the link after it began: that link is made
+    // again from there (or becomes a retract).
+    let mut q = Program { moves };
+    q.mend(regions, wall);
+    Some((q, Relink { at, standing_deg: standing[best].to_degrees(), retract: !safe }))
 }
 
 #[cfg(test)]

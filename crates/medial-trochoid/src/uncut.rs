@@ -73,6 +73,15 @@ fn grow(shrunk: &[Contour], rho: f64) -> Result<Vec<Contour>, OpenError> {
     Ok(grown.contours)
 }
 
+/// Area (mm²) of `regions` that no tool of radius `wall` reaches at all: the regions less their
+/// opening by `wall` (the fillets of inside corners, acute tips, gaps narrower than 2·`wall`).
+/// `None` if the opening cannot be made.
+pub fn unreachable_area(regions: &[Region], wall: f64) -> Option<f64> {
+    let opened = open(regions, wall).ok()?;
+    let total: f64 = regions.iter().map(area).sum();
+    Some((total - opened.regions.iter().map(area).sum::<f64>()).max(0.0))
+}
+
 /// Area of a region (mm²): the boundary's less the islands'.
 pub fn area(r: &Region) -> f64 {
     r.outer.area().abs() - r.islands.iter().map(|i| i.area().abs()).sum::<f64>()

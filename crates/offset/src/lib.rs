@@ -16,6 +16,7 @@ pub mod space;
 
 use camkit::contour::offset::Side;
 use camkit::contour::pocket::{self, Passes, PocketOptions};
+use camkit::contour::region::Region;
 use camkit::contour::table::{self as contour_table, Source};
 use camkit::contour::{Contour, OffsetOptions, Seg, offset_contour};
 use camkit::error::{Error, Location, Result};
@@ -154,9 +155,11 @@ pub fn pocket_mode(table: &Table, name: &str, opts: &PocketOptions) -> Result<Ou
         Error::check(format!("pocket of path {} at offset {} mm: {}", s.path, e.distance, e.error))
             .at(located(name, s.line))
     })?;
+    let centre = centre_lines(&regions, &result.passes, opts);
+    let passes: Vec<&pocket::Pass> = result.passes.iter().chain(&centre).collect();
     let (mut out, k) = output_table(table);
     let mut warnings = Vec::new();
-    if result.passes.is_empty() {
+    if passes.is_empty() {
         warnings.push(format!("the tool (radius {} mm) does not fit in any region: nothing to cut", opts.radius));
     }
     if turned > 0 {
@@ -165,28 +168,61 @@ pub fn pocket_mode(table: &Table, name: &str, opts: &PocketOptions) -> Result<Ou
         ));
     }
     let mut drawn = Vec::new();
-    for (path, pass) in result.passes.iter().enumerate() {
+    for (path, pass) in passes.iter().enumerate() {
         let s = &sources[regions[pass.region].outer_source];
         push_contour(&mut out, k, &pass.contour, path as i64, s.z, &table.rows[s.row], pass.distance);
         drawn.push(pass.contour.clone());
     }
-    let levels = result.passes.iter().map(|p| p.level + 1).max().unwrap_or(0);
+    let levels = passes.iter().map(|p| p.level + 1).max().unwrap_or(0);
     report
         .set("regions", regions.len())
         .set("islands", regions.iter().map(|r| r.islands.len()).sum::<usize>())
         .set("reoriented_contours", turned)
-        .set("passes", result.passes.len())
+        .set("passes", passes.len())
+        .set("centre_line_passes", centre.len())
         .set("levels", levels)
         .set("clean_up_passes", result.clean_ups)
         .set("verified_pieces", result.check.pieces)
         .set("largest_deviation_mm", result.check.deviation())
         .set("kernel_runs", result.attempts)
         .set("offsets_on_cleaned_input", result.cleaned);
-    let title =
-        format!("{name}: {} passes, tool radius {} mm, step {} mm", result.passes.len(), opts.radius, opts.step);
+    let title = format!("{name}: {} passes, tool radius {} mm, step {} mm", passes.len(), opts.radius, opts.step);
     let loops: Vec<Contour> = sources.iter().map(|s| s.contour.clone()).collect();
     let plot = plot::passes(&title, &loops, &drawn);
     Ok(Outcome { table: out, report, plot, warnings })
+}
+
+/// Passes along the centre line of the regions that have no pass in `passes`: a region at most
+/// 2R wide everywhere (a slot exactly 2R wide) has an empty inside at R, the region offset
+/// dropping the loop of zero width, while the inward offset of its boundary alone is the centre
+/// line, as contour mode cuts it. A centre line is kept only if every piece keeps R (within
+/// `OFFSET_TOL`) from every loop of the region, islands included.
+fn centre_lines(regions: &[Region], passes: &[pocket::Pass], opts: &PocketOptions) -> Vec<pocket::Pass> {
+    let r = opts.radius;
+    let mut out = Vec::new();
+    for (ri, region) in regions.iter().enumerate() {
+        if passes.iter().any(|p| p.region == ri) {
+            continue;
+        }
+        // The boundary runs counter-clockwise: the inside is on its left.
+        let Ok(o) = offset_contour(&region.outer, r, Side::Left, &opts.offset) else { continue };
+        for c in o.contours {
+            let clear = c.segs().all(|s| {
+                region.loops().iter().flat_map(|l| l.segs()).all(|b| b.min_distance(&s) >= r - camkit::tol::OFFSET_TOL)
+            });
+            if clear {
+                out.push(pocket::Pass {
+                    contour: c,
+                    distance: r,
+                    level: 0,
+                    region: ri,
+                    island: false,
+                    clean_up: false,
+                });
+            }
+        }
+    }
+    out
 }
 
 /// Which axis points up (along the tool) in profile mode.
