@@ -274,3 +274,24 @@ fn closed_output_pipe_is_not_an_error() {
     assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
     assert!(out.stderr.is_empty(), "{}", String::from_utf8_lossy(&out.stderr));
 }
+
+/// Tool axes that differ only by round-off from an earlier stage (1e-16 in `i`) do not split a
+/// run: a quarter circle of 200 points becomes one arc; axes 0.01° apart are kept apart.
+#[test]
+fn axes_equal_to_round_off_merge() {
+    let w = Work::new();
+    let table = |wobble: f64| {
+        let mut s = String::from("path,x,y,z,i,j,k\n");
+        for n in 0..=200 {
+            let a = std::f64::consts::FRAC_PI_2 * n as f64 / 200.0;
+            let i = if n % 2 == 0 { 0.0 } else { wobble };
+            s.push_str(&format!("0,{},{},0,{i:e},0,{}\n", 20.0 * a.cos(), 20.0 * a.sin(), (1.0 - i * i).sqrt()));
+        }
+        s
+    };
+    w.write("roundoff.csv", table(1e-16));
+    w.write("tilted.csv", table(0.01f64.to_radians().sin()));
+    let rows = |name: &str| w.run(BIN, &[name, "--tol", "0.001"], b"").ok().lines().count() - 1;
+    assert_eq!(rows("roundoff.csv"), 2, "a start row and one arc");
+    assert_eq!(rows("tilted.csv"), 201, "every row its own axis");
+}

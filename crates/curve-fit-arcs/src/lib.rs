@@ -66,6 +66,8 @@ pub struct Options {
     pub curvature_threshold: f64,
     /// Largest relative difference of extrusion per mm between moves merged into one.
     pub e_rate_tol: f64,
+    /// Largest angle (radians) between tool axes of table rows merged into one run.
+    pub axis_tol: f64,
 }
 
 impl Default for Options {
@@ -81,6 +83,7 @@ impl Default for Options {
             corner: 60f64.to_radians(),
             curvature_threshold: 1e-3,
             e_rate_tol: 0.05,
+            axis_tol: 1e-7f64.to_radians(),
         }
     }
 }

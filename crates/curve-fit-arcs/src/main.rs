@@ -73,6 +73,10 @@ struct Args {
     /// Largest relative difference of extrusion per mm between G-code moves merged into one.
     #[arg(long, default_value_t = 0.05, value_name = "FRACTION")]
     e_rate_tol: f64,
+    /// Tool axes (i,j,k) of table rows this close (degrees) count as one axis, so that round-off
+    /// from an earlier stage does not split a run; the merged row keeps its own.
+    #[arg(long, default_value_t = 1e-7, value_name = "DEG")]
+    axis_tol: f64,
     /// Decimals of written positions (default: G-code keeps the input's, at least 3 (mm) or 4
     /// (inch); tables are written exactly).
     #[arg(long, value_name = "N")]
@@ -143,6 +147,7 @@ fn options(args: &Args) -> Result<Options> {
         corner: positive(args.corner, "--corner")?.to_radians(),
         curvature_threshold: positive(args.curvature_threshold, "--curvature-threshold")?,
         e_rate_tol: positive(args.e_rate_tol, "--e-rate-tol")?,
+        axis_tol: positive(args.axis_tol, "--axis-tol")?.to_radians(),
     })
 }
 

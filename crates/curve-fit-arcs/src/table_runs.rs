@@ -29,12 +29,14 @@ pub struct TableError {
     pub cause: Unfittable,
 }
 
-/// True if `row` continues a run whose first merged row is `head` and whose start row is `start`.
-fn continues(start: &Row, head: &Row, row: &Row) -> bool {
+/// True if `row` continues a run whose first merged row is `head` and whose start row is `start`
+/// (tool axes within `axis_tol` radians of the head's).
+fn continues(start: &Row, head: &Row, row: &Row, axis_tol: f64) -> bool {
+    let apart = row.axis.cross(&head.axis).norm().atan2(row.axis.dot(&head.axis));
     row.path == start.path
         && row.mv == Move::Line
         && row.f == head.f
-        && row.axis == head.axis
+        && apart <= axis_tol
         && row.s == head.s
         && row.tag == head.tag
 }
@@ -61,7 +63,7 @@ pub fn fit_table(
     while k + 1 < rows.len() {
         // Rows k+1..=end continue a run starting at row k.
         let mut end = k;
-        while end + 1 < rows.len() && continues(&rows[k], &rows[k + 1], &rows[end + 1]) {
+        while end + 1 < rows.len() && continues(&rows[k], &rows[k + 1], &rows[end + 1], opts.axis_tol) {
             end += 1;
         }
         if end == k {
