@@ -179,9 +179,20 @@ impl Fields<'_> {
         match self.text(col)? {
             None => Ok(None),
             Some((_, "")) => Ok(None),
-            Some((i, t)) => parse_finite(t)
-                .map(Some)
-                .map_err(|e| Error::input(e.message(t)).at(self.loc(i, columns::spec(col).name))),
+            Some((i, t)) => {
+                let v =
+                    parse_finite(t).map_err(|e| Error::input(e.message(t)).at(self.loc(i, columns::spec(col).name)))?;
+                let position =
+                    matches!(col, Col::X | Col::Y | Col::Z | Col::Xc | Col::Yc | Col::Zc | Col::Px | Col::Py | Col::Pz);
+                if position && v.abs() > crate::tol::COORD_LIMIT {
+                    return Err(Error::input(format!(
+                        "{v:e} mm is beyond ±{:e} mm, where the micrometre tolerances fall below the floating-point resolution",
+                        crate::tol::COORD_LIMIT
+                    ))
+                    .at(self.loc(i, columns::spec(col).name)));
+                }
+                Ok(Some(v))
+            }
         }
     }
 
@@ -308,6 +319,8 @@ mod tests {
         let e = read(&input("x,y,z\n1,2,3\n1,2,\"1,2x\"\n"), &[Col::X, Col::Y]).unwrap_err();
         assert_eq!(e.to_string(), "in.csv:3:3 (z): expected a number, found \"1,2x\"");
         assert_eq!(e.exit_status(), 2);
+        let e = read(&input("x,y\n1,1e12\n"), &[Col::X, Col::Y]).unwrap_err();
+        assert!(e.to_string().starts_with("in.csv:2:2 (y): 1e12 mm is beyond ±1e9 mm"), "{e}");
         let e = read(&input("x,y\n1,NaN\n"), &[Col::X, Col::Y]).unwrap_err();
         assert_eq!(e.to_string(), "in.csv:2:2 (y): expected a finite number, found \"NaN\"");
     }
