@@ -601,3 +601,31 @@ fn linuxcnc_interpreter_agrees() {
         }
     }
 }
+
+/// Issue 20 (D4): a document must be the JSON object it claims to be. serde reads a structure
+/// from an array by position, so `[1, 2, 3]` was taken for the frame `xc 1, yc 2, za 3` (exit 0);
+/// arrays in place of the machine document, or of an object inside it, were read the same way.
+#[test]
+fn documents_given_as_arrays_are_refused() {
+    let w = Work::new();
+    w.write("ok.csv", "x,y,z,i,j,k,f\n0,0,0,0,0,1,100\n1,0,0,0,0,1,100\n");
+    let m = machine("paper002-ac.json");
+    w.write("frame.json", "[1, 2, 3]\n");
+    w.run(BIN, &["ok.csv", "-m", &m, "--frame", "frame.json", "-o", "o.nc"], b"")
+        .fails(2, "frame.json:1:1: expected a JSON object, found an array");
+    assert!(!w.exists("o.nc"));
+    w.write("frame.json", "\n  [1, 2, 3, \"x\", null]");
+    w.run(BIN, &["ok.csv", "-m", &m, "--frame", "frame.json"], b"")
+        .fails(2, "frame.json:2:3: expected a JSON object, found an array");
+    let doc: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&m).unwrap()).unwrap();
+    let mut nested = doc.clone();
+    nested["frame"] = serde_json::json!([0.42, -0.31, 62.5]);
+    w.write("m.json", nested.to_string());
+    w.run(BIN, &["ok.csv", "-m", "m.json"], b"").fails(2, "m.json (frame): expected a JSON object, found an array");
+    let mut link = doc.clone();
+    link["chain"][1] = serde_json::json!([null, null, null, null, null, null, null, [0, 0.35, 0]]);
+    w.write("m.json", link.to_string());
+    w.run(BIN, &["ok.csv", "-m", "m.json"], b"").fails(2, "m.json (chain[1]): expected a JSON object, found an array");
+    w.write("m.json", serde_json::json!([doc]).to_string());
+    w.run(BIN, &["ok.csv", "-m", "m.json"], b"").fails(2, "m.json:1:1: expected a JSON object, found an array");
+}
