@@ -629,3 +629,17 @@ fn documents_given_as_arrays_are_refused() {
     w.write("m.json", serde_json::json!([doc]).to_string());
     w.run(BIN, &["ok.csv", "-m", "m.json"], b"").fails(2, "m.json:1:1: expected a JSON object, found an array");
 }
+
+/// Issue 20 (D11): a program without motion blocks given to `--verify` was measured: "deviates
+/// 0.000000 mm ... rows inf mm", exit 1. It is bad input.
+#[test]
+fn verify_refuses_a_program_without_motion() {
+    let w = Work::new();
+    w.write("ok.csv", "x,y,z,i,j,k,f\n0,0,0,0,0,1,100\n1,0,0,0,0,1,100\n");
+    let m = machine("paper002-ac.json");
+    for (name, text) in [("empty.ngc", ""), ("header.ngc", "%\nG21 G90\nG53 G0 Z0\nM30\n%\n")] {
+        w.write(name, text);
+        w.run(BIN, &["ok.csv", "-m", &m, "--verify", name], b"")
+            .fails(2, &format!("{name}: the program has no motion blocks"));
+    }
+}

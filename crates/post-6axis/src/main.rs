@@ -183,6 +183,11 @@ fn run(args: Args) -> Result<()> {
         let program = read_axes(&nc_input.name, nc_input.text()?)?;
         let reading = readback::Reading::new(&machine, &chain);
         let poses = readback::poses(&program, &reading);
+        if poses.iter().all(Option::is_none) {
+            // Nothing to compare: every row would be "missed" by an infinite distance.
+            return Err(Error::input("the program has no motion blocks (in workpiece coordinates, every axis known)")
+                .at(Location::file(&nc_input.name)));
+        }
         let d = readback::verify(&rows, &poses, &reading, 32, settings.tol);
         deviation_keys(&mut report, &d);
         report.set("rows", rows.len()).set("tol_mm", settings.tol).set("angle_tol_deg", settings.angle_tol);
