@@ -380,8 +380,8 @@ fn nearest_on_path(p: &P3, path: &[P3], hint: Option<usize>, far: f64) -> (usize
 }
 
 /// Angle (radians) of the tool axis from the CL axis where the tool is: over the CL points within
-/// `tol` of the tip on segment `seg` (at distance `d`) and the segments it shares a row with, the
-/// least angle to the axis arc there. A short segment that turns the axis with the tip (nearly)
+/// `tol` of the tip on segment `seg` (at distance `d`) and the run of segments joined to it that
+/// stay within `tol` of the tip, the least angle to the axis arc there. A short segment that turns the axis with the tip (nearly)
 /// still, or a pass closing on its start, leaves the tip's nearest parameter undefined: every
 /// axis along the turn is then where the tool may be, as planning measures it.
 #[allow(clippy::too_many_arguments)]
@@ -395,7 +395,6 @@ fn axis_deviation(
     d: f64,
     tol: f64,
 ) -> f64 {
-    let (i0, i1) = segs[seg];
     let at = |k: usize, dk: f64| {
         let (a, b) = segs[k];
         let len = (cl[b].tip - cl[a].tip).norm();
@@ -405,13 +404,27 @@ fn axis_deviation(
         vector_arc(axis, &slerp(&cl[a].axis, &cl[b].axis, lo), &slerp(&cl[a].axis, &cl[b].axis, hi))
     };
     let mut best = at(seg, d);
-    let neighbours =
-        [seg.checked_sub(1).filter(|&k| segs[k].1 == i0), Some(seg + 1).filter(|&k| k < segs.len() && segs[k].0 == i1)];
-    for k in neighbours.into_iter().flatten() {
-        let dk = paths[k].distance(tip);
-        if dk <= tol {
-            best = best.min(at(k, dk));
+    // Along the pass both ways, while the segments stay within `tol` of the tip: a turn on the
+    // spot is a run of zero-length segments all as near as the segment leaving it, and the tip's
+    // nearest may be any of them (it once took the one leaving a 20° turn and measured the turn's
+    // first block against the turn's last 10°).
+    let mut k = seg;
+    while let Some(prev) = k.checked_sub(1).filter(|&p| segs[p].1 == segs[k].0) {
+        let dk = paths[prev].distance(tip);
+        if dk > tol {
+            break;
         }
+        best = best.min(at(prev, dk));
+        k = prev;
+    }
+    let mut k = seg;
+    while let Some(next) = Some(k + 1).filter(|&n| n < segs.len() && segs[n].0 == segs[k].1) {
+        let dk = paths[next].distance(tip);
+        if dk > tol {
+            break;
+        }
+        best = best.min(at(next, dk));
+        k = next;
     }
     best
 }
