@@ -707,3 +707,157 @@ fn verify_refuses_a_program_without_motion() {
             .fails(2, &format!("{name}: the program has no motion blocks"));
     }
 }
+
+/// Issue 20 (the class of D4, D6, D11): every numeric option at 0, −1, NaN, ±inf, 1e-300, 1e300
+/// and seeded mutations of the machine and frame documents (a leaf replaced by such a number, a
+/// string, null, an array or an object; a key dropped; a default field added) give exit 0, 1 or
+/// 2, one line on stderr at most, no panic, within 20 s each; an option value is posted (and
+/// `--verify` with it passes) or refused as bad input, never a failed check. The feed options
+/// once wrote F0 (`--feed 1e-9`, `--rotary-radius 1e300`: "the written program does not read
+/// back", exit 1) or a 300-digit F word (`--feed 1e300`, exit 0), and `--spindle-tol 1e-9` was
+/// planned for and missed (0.0030°, exit 1).
+#[test]
+fn numeric_options_and_mutated_documents_are_refused_or_posted() {
+    let w = Work::new();
+    let rows: Vec<Row> = (0..40)
+        .map(|k| {
+            let t = k as f64 / 39.0;
+            let (th, ph) = ((30.0 * (0.3 + 0.7 * t)).to_radians(), (120.0 * t).to_radians());
+            let axis = V3::new(th.sin() * ph.cos(), th.sin() * ph.sin(), th.cos());
+            let tip = P3::new(-20.0 + 40.0 * t, 10.0 * (2.0 * t).sin(), 5.0 * (4.0 * t).cos());
+            Row { path: 0, rapid: k == 0, tip, axis, s: Some(90.0 * t) }
+        })
+        .collect();
+    w.write("s.csv", csv(&rows, 600.0));
+    let plain: Vec<Row> = rows.iter().map(|r| Row { s: None, ..*r }).collect();
+    let nf = csv(&plain, 600.0).replace(",600\n", "\n").replace(",f\n", "\n");
+    w.write("nf.csv", nf);
+    let mut seen = [0usize; 3];
+    let mut check = |args: &[&str]| {
+        let started = std::time::Instant::now();
+        let o = w.run(BIN, args, b"");
+        let took = started.elapsed().as_secs_f64();
+        assert!((0..=2).contains(&o.status), "{args:?}: status {}: {}", o.status, o.stderr);
+        assert!(o.stderr.trim_end().lines().count() <= 1, "{args:?}: {}", o.stderr);
+        assert!(!o.stderr.contains("panicked"), "{args:?}: {}", o.stderr);
+        assert!(took < 20.0, "{args:?}: {took} s");
+        seen[o.status as usize] += 1;
+        o
+    };
+    let values = ["0", "-1", "NaN", "inf", "-inf", "1e-300", "1e300", "1e-9", "1e9"];
+    let options = ["--tol", "--angle-tol", "--spindle-tol", "--feed", "--rotary-radius"];
+    for m in ["paper002-ac.json", "paper000-sixaxis-b.json"] {
+        let m = machine(m);
+        let input = if m.contains("sixaxis") { "s.csv" } else { "nf.csv" };
+        for o in options {
+            for v in values {
+                let arg = format!("{o}={v}");
+                let feed = if o == "--feed" { vec![] } else { vec!["--feed", "500"] };
+                let mut args = vec![input, "-m", &m, &arg, "-o", "o.nc"];
+                args.extend(feed);
+                let out = check(&args);
+                // A value the program cannot be made to is bad input, not a failed check.
+                assert_ne!(out.status, 1, "{arg}: {}", out.stderr);
+                if out.status == 0 {
+                    // What is delivered reads back, and its F words are short.
+                    let nc = w.read("o.nc");
+                    assert!(nc.split_whitespace().all(|word| !word.starts_with('F') || word.len() < 20), "{arg}");
+                    let verify = check(&[input, "-m", &m, "--verify", "o.nc", &arg, "--feed", "500"]);
+                    assert_eq!(verify.status, 0, "{arg}: {}", verify.stderr);
+                }
+            }
+        }
+    }
+    w.write("frame.json", r#"{"xc": 1.0, "yc": 2.0, "za": 50.0}"#);
+    check(&["nf.csv", "-m", &machine("paper002-ac.json"), "--frame", "frame.json", "--feed", "500"]).ok();
+    // Seeded mutations of the documents.
+    let mut seed = 20u64;
+    let mut next = |n: usize| {
+        seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        ((seed >> 33) as usize) % n
+    };
+    let leaves = [
+        serde_json::json!(0),
+        serde_json::json!(-1),
+        serde_json::json!(1e-300),
+        serde_json::json!(1e300),
+        serde_json::json!(-1e300),
+        serde_json::json!(44.99),
+        serde_json::json!(12),
+        serde_json::json!("x"),
+        serde_json::Value::Null,
+        serde_json::json!([]),
+        serde_json::json!([1e300, -1e300]),
+        serde_json::json!({}),
+        serde_json::json!(true),
+    ];
+    let extra = [
+        "/program/decimals",
+        "/program/decimals/linear",
+        "/program/decimals/rotary",
+        "/program/decimals/feed",
+        "/program/decimals/inverse_time_digits",
+        "/program/block_numbers",
+        "/program/units",
+        "/travel",
+        "/travel/x",
+        "/singular_cone",
+        "/singular",
+        "/policy",
+        "/frame",
+        "/frame/za",
+    ];
+    fn pointers(v: &serde_json::Value, at: String, out: &mut Vec<String>) {
+        match v {
+            serde_json::Value::Object(m) => m.iter().for_each(|(k, x)| pointers(x, format!("{at}/{k}"), out)),
+            serde_json::Value::Array(a) => {
+                a.iter().enumerate().for_each(|(i, x)| pointers(x, format!("{at}/{i}"), out))
+            }
+            _ => {}
+        }
+        out.push(at);
+    }
+    for (name, input) in
+        [("paper002-ac.json", "nf.csv"), ("paper000-sixaxis-b.json", "s.csv"), ("head-bc.json", "nf.csv")]
+    {
+        let doc: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(machine(name)).unwrap()).unwrap();
+        let mut at = Vec::new();
+        pointers(&doc, String::new(), &mut at);
+        at.retain(|p| !p.is_empty());
+        at.extend(extra.iter().map(|s| s.to_string()));
+        for _ in 0..60 {
+            let mut d = doc.clone();
+            let p = &at[next(at.len())];
+            let (parent, key) = p.rsplit_once('/').unwrap();
+            let leaf = leaves[next(leaves.len())].clone();
+            let drop = next(8) == 0;
+            // Parents along the way made objects, so that an added field lands.
+            let mut cur = &mut d;
+            for part in parent.split('/').skip(1) {
+                if cur.is_object() && cur.get(part).is_none() {
+                    cur[part] = serde_json::json!({});
+                }
+                cur = match cur {
+                    serde_json::Value::Array(a) => &mut a[part.parse::<usize>().unwrap()],
+                    other => &mut other[part],
+                };
+            }
+            match cur {
+                serde_json::Value::Object(o) if drop => {
+                    o.remove(key);
+                }
+                serde_json::Value::Object(o) => {
+                    o.insert(key.to_string(), leaf);
+                }
+                serde_json::Value::Array(a) => a[key.parse::<usize>().unwrap()] = leaf,
+                _ => {}
+            }
+            w.write("m.json", d.to_string());
+            check(&[input, "-m", "m.json", "--feed", "500", "-o", "o.nc"]);
+            w.write("f.json", serde_json::json!({"xc": 1.0, "yc": leaves[next(leaves.len())], "za": 50.0}).to_string());
+            check(&["nf.csv", "-m", &machine("paper002-ac.json"), "--frame", "f.json", "--feed", "500"]);
+        }
+    }
+    eprintln!("outcomes (exit 0, 1, 2): {seen:?}");
+    assert!(seen[0] > 20 && seen[2] > 100, "{seen:?}");
+}

@@ -99,6 +99,12 @@ fn main() -> ExitCode {
     cli::run("post-6axis", || run(Args::parse()))
 }
 
+/// A number as typed for a message: plain, or in exponent form when plain would run to dozens of
+/// digits.
+fn short(v: f64) -> String {
+    if v != 0.0 && !(1e-6..1e9).contains(&v.abs()) { format!("{v:e}") } else { v.to_string() }
+}
+
 fn load_machine(args: &Args) -> Result<(Machine, Chain)> {
     let (machine, mut chain) = Machine::read(&args.machine)?;
     if let Some(path) = &args.frame {
@@ -124,18 +130,29 @@ fn with_job(mut machine: Machine, job: &Job) -> Result<Machine> {
 fn run(args: Args) -> Result<()> {
     let started = Instant::now();
     let job = args.setup.as_deref().map(Setup::read).transpose()?;
+    let (machine, chain) = load_machine(&args)?;
+    let within = |v: f64, (lo, hi): (f64, f64), what: &str| {
+        positive(v, what).and_then(|v| match v {
+            v if (lo..=hi).contains(&v) => Ok(v),
+            _ => Err(Error::input(format!("{what} must be from {lo} to {hi}, got {}", short(v)))),
+        })
+    };
+    let feed_range = post_6axis::feed_range(&machine);
     let settings = Settings {
         tol: positive(args.tol, "--tol")?,
         angle_tol: positive(args.angle_tol, "--angle-tol")?,
         spindle_tol: positive(args.spindle_tol, "--spindle-tol")?,
-        rotary_radius: positive(args.rotary_radius, "--rotary-radius")?,
-        feed: args
-            .feed
-            .map(|f| positive(f, "--feed"))
-            .transpose()?
-            .or(job.as_ref().and_then(|j| j.tool.cutting_feed())),
+        rotary_radius: within(args.rotary_radius, (0.0, post_6axis::MAX_ROTARY_RADIUS), "--rotary-radius")?,
+        feed: match args.feed {
+            Some(f) => Some(within(f, feed_range, "--feed")?),
+            None => match job.as_ref().and_then(|j| Some((j, j.tool.cutting_feed()?))) {
+                Some((j, f)) => Some(
+                    within(f, feed_range, "the tool's cutting feed").map_err(|e| e.at(Location::file(&j.tool_file)))?,
+                ),
+                None => None,
+            },
+        },
     };
-    let (machine, chain) = load_machine(&args)?;
     let machine = match &job {
         Some(j) => with_job(machine, j)?,
         None => machine,
