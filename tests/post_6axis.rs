@@ -692,6 +692,15 @@ fn a_turn_about_the_standing_tip_reads_back_on_every_machine() {
         w.run(BIN, &["turn.csv", "-m", &m, "--verify", "turn.nc"], b"").ok();
         w.run(BIN, &["turn.csv", "-m", &m, "--verify", "bad.nc"], b"").fails(1, "deviates");
     }
+    // A turn of 2 000 rows (0.02° apart) on the spot: matched in order, each sample's axis
+    // against the rows near where the previous one matched (not the whole turn: 3.7 s of CPU).
+    let mut long = vec![at(0.0, 0.0, true)];
+    long.extend((0..=2000).map(|k| at(10.0, 40.0 * k as f64 / 2000.0, false)));
+    long.push(at(20.0, 40.0, false));
+    w.write("long.csv", csv(&long, 1000.0));
+    w.run(BIN, &["long.csv", "-m", &machine("paper002-ac.json"), "-o", "long.nc", "--report", "r.json"], b"").ok();
+    let r = report(&w, "r.json");
+    assert!(figure(&r, "largest_axis_deviation_deg") <= 0.05 && figure(&r, "blocks") > 2000.0, "{r}");
 }
 
 /// Issue 20 (D11): a program without motion blocks given to `--verify` was measured: "deviates
