@@ -724,7 +724,7 @@ fn verify_refuses_a_program_without_motion() {
 /// `--verify` with it passes) or refused as bad input, never a failed check. The feed options
 /// once wrote F0 (`--feed 1e-9`, `--rotary-radius 1e300`: "the written program does not read
 /// back", exit 1) or a 300-digit F word (`--feed 1e300`, exit 0), and `--spindle-tol 1e-9` was
-/// planned for and missed (0.0030°, exit 1).
+/// planned for and missed (0.0030°, exit 1); a setup's plunge feed of 1e-9 mm/min wrote F0.
 #[test]
 fn numeric_options_and_mutated_documents_are_refused_or_posted() {
     let w = Work::new();
@@ -867,6 +867,16 @@ fn numeric_options_and_mutated_documents_are_refused_or_posted() {
             check(&["nf.csv", "-m", &machine("paper002-ac.json"), "--frame", "f.json", "--feed", "500"]);
         }
     }
+    // A setup's plunge feed is written too: 1e-9 mm/min was F0 (exit 1).
+    let jobs = |f: &str| data(&format!("jobs/{f}")).to_str().unwrap().to_string();
+    let mut setup: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(jobs("globe.json")).unwrap()).unwrap();
+    setup["tool"] = jobs("flat-d0.2.json").into();
+    setup["part"]["model"] = jobs("globe-sphere.json").into();
+    setup["plunge"] = serde_json::json!({"feed": 1e-9});
+    w.write("setup.json", setup.to_string());
+    check(&["nf.csv", "-m", &machine("paper002-ac.json"), "--setup", "setup.json", "--feed", "500"])
+        .fails(2, "setup.json (plunge.feed): the plunge feed must be from 0.1 to 1000000, got 1e-9");
     eprintln!("outcomes (exit 0, 1, 2): {seen:?}");
     assert!(seen[0] > 20 && seen[2] > 100, "{seen:?}");
 }

@@ -153,6 +153,10 @@ fn run(args: Args) -> Result<()> {
             },
         },
     };
+    if let Some(j) = &job {
+        // The setup's plunge feed (or the tool's) is written too: F0 below the range.
+        within(j.plunge_feed, feed_range, "the plunge feed").map_err(|e| j.error("plunge.feed", e.message))?;
+    }
     let machine = match &job {
         Some(j) => with_job(machine, j)?,
         None => machine,
