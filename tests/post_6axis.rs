@@ -601,3 +601,282 @@ fn linuxcnc_interpreter_agrees() {
         }
     }
 }
+
+/// Issue 20 (D4): a document must be the JSON object it claims to be. serde reads a structure
+/// from an array by position, so `[1, 2, 3]` was taken for the frame `xc 1, yc 2, za 3` (exit 0);
+/// arrays in place of the machine document, or of an object inside it, were read the same way.
+#[test]
+fn documents_given_as_arrays_are_refused() {
+    let w = Work::new();
+    w.write("ok.csv", "x,y,z,i,j,k,f\n0,0,0,0,0,1,100\n1,0,0,0,0,1,100\n");
+    let m = machine("paper002-ac.json");
+    w.write("frame.json", "[1, 2, 3]\n");
+    w.run(BIN, &["ok.csv", "-m", &m, "--frame", "frame.json", "-o", "o.nc"], b"")
+        .fails(2, "frame.json:1:1: expected a JSON object, found an array");
+    assert!(!w.exists("o.nc"));
+    w.write("frame.json", "\n  [1, 2, 3, \"x\", null]");
+    w.run(BIN, &["ok.csv", "-m", &m, "--frame", "frame.json"], b"")
+        .fails(2, "frame.json:2:3: expected a JSON object, found an array");
+    let doc: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&m).unwrap()).unwrap();
+    let mut nested = doc.clone();
+    nested["frame"] = serde_json::json!([0.42, -0.31, 62.5]);
+    w.write("m.json", nested.to_string());
+    w.run(BIN, &["ok.csv", "-m", "m.json"], b"").fails(2, "m.json (frame): expected a JSON object, found an array");
+    let mut link = doc.clone();
+    link["chain"][1] = serde_json::json!([null, null, null, null, null, null, null, [0, 0.35, 0]]);
+    w.write("m.json", link.to_string());
+    w.run(BIN, &["ok.csv", "-m", "m.json"], b"").fails(2, "m.json (chain[1]): expected a JSON object, found an array");
+    w.write("m.json", serde_json::json!([doc]).to_string());
+    w.run(BIN, &["ok.csv", "-m", "m.json"], b"").fails(2, "m.json:1:1: expected a JSON object, found an array");
+}
+
+/// Issue 20 (D6): the tool tip standing still while the axis turns 0–20°, then a cut. On every
+/// multi-axis machine the read-back measured the turn's first blocks against the segment leaving
+/// the turn and its neighbour (the last 10° of the turn): "the tool axis deviates 8.75°" on
+/// paper002-ac (exit 1), no program. A block whose rotary word is changed is still refused by
+/// `--verify`.
+#[test]
+fn a_turn_about_the_standing_tip_reads_back_on_every_machine() {
+    let w = Work::new();
+    let tilt = |deg: f64| V3::new(deg.to_radians().sin(), 0.0, deg.to_radians().cos());
+    let at =
+        |x: f64, deg: f64, rapid: bool| Row { path: 0, rapid, tip: P3::new(x, 0.0, 5.0), axis: tilt(deg), s: None };
+    let rows = [at(10.0, 0.0, true), at(10.0, 10.0, false), at(10.0, 20.0, false), at(20.0, 20.0, false)];
+    w.write("turn.csv", csv(&rows, 1000.0));
+    let names = [
+        "paper002-ac.json",
+        "paper002-ac-fanuc-tcp.json",
+        "paper000-sixaxis-b.json",
+        "paper000-sixaxis-m19.json",
+        "table-bc-fanuc.json",
+        "head-bc.json",
+        "head-ab.json",
+        "head-table-cb.json",
+    ];
+    for name in names {
+        let m = machine(name);
+        w.run(BIN, &["turn.csv", "-m", &m, "-o", "turn.nc", "--report", "r.json"], b"").ok();
+        let r = report(&w, "r.json");
+        assert!(figure(&r, "largest_axis_deviation_deg") <= 0.05, "{name}: {r}");
+        // One feed block in the middle of the turn, its first rotary word 15° on.
+        let nc = w.read("turn.nc");
+        let turn: Vec<usize> = (0..nc.lines().count())
+            .filter(|&i| {
+                let l = nc.lines().nth(i).unwrap();
+                let feed = !l.contains('(') && !l.contains("G0 ");
+                feed && (l.contains(" A") || l.contains(" B") || l.contains(" C"))
+            })
+            .collect();
+        let mid = turn[turn.len() / 2];
+        let mutated: Vec<String> = nc
+            .lines()
+            .enumerate()
+            .map(|(i, l)| {
+                if i != mid {
+                    return l.to_string();
+                }
+                let mut done = false;
+                l.split(' ')
+                    .map(|word| match word.split_at_checked(1) {
+                        Some((a @ ("A" | "B" | "C"), v)) if !done => {
+                            done = true;
+                            format!("{a}{}", v.parse::<f64>().unwrap() + 15.0)
+                        }
+                        _ => word.to_string(),
+                    })
+                    .collect::<Vec<_>>()
+                    .join(" ")
+            })
+            .collect();
+        w.write("bad.nc", mutated.join("\n") + "\n");
+        w.run(BIN, &["turn.csv", "-m", &m, "--verify", "turn.nc"], b"").ok();
+        w.run(BIN, &["turn.csv", "-m", &m, "--verify", "bad.nc"], b"").fails(1, "deviates");
+    }
+    // A turn of 2 000 rows (0.02° apart) on the spot: matched in order, each sample's axis
+    // against the rows near where the previous one matched (not the whole turn: 3.7 s of CPU).
+    let mut long = vec![at(0.0, 0.0, true)];
+    long.extend((0..=2000).map(|k| at(10.0, 40.0 * k as f64 / 2000.0, false)));
+    long.push(at(20.0, 40.0, false));
+    w.write("long.csv", csv(&long, 1000.0));
+    w.run(BIN, &["long.csv", "-m", &machine("paper002-ac.json"), "-o", "long.nc", "--report", "r.json"], b"").ok();
+    let r = report(&w, "r.json");
+    assert!(figure(&r, "largest_axis_deviation_deg") <= 0.05 && figure(&r, "blocks") > 2000.0, "{r}");
+}
+
+/// Issue 20 (D11): a program without motion blocks given to `--verify` was measured: "deviates
+/// 0.000000 mm ... rows inf mm", exit 1. It is bad input.
+#[test]
+fn verify_refuses_a_program_without_motion() {
+    let w = Work::new();
+    w.write("ok.csv", "x,y,z,i,j,k,f\n0,0,0,0,0,1,100\n1,0,0,0,0,1,100\n");
+    let m = machine("paper002-ac.json");
+    for (name, text) in [("empty.ngc", ""), ("header.ngc", "%\nG21 G90\nG53 G0 Z0\nM30\n%\n")] {
+        w.write(name, text);
+        w.run(BIN, &["ok.csv", "-m", &m, "--verify", name], b"")
+            .fails(2, &format!("{name}: the program has no motion blocks"));
+    }
+}
+
+/// Issue 20 (the class of D4, D6, D11): every numeric option at 0, −1, NaN, ±inf, 1e-300, 1e300
+/// and seeded mutations of the machine and frame documents (a leaf replaced by such a number, a
+/// string, null, an array or an object; a key dropped; a default field added) give exit 0, 1 or
+/// 2, one line on stderr at most, no panic, within 20 s each; an option value is posted (and
+/// `--verify` with it passes) or refused as bad input, never a failed check. The feed options
+/// once wrote F0 (`--feed 1e-9`, `--rotary-radius 1e300`: "the written program does not read
+/// back", exit 1) or a 300-digit F word (`--feed 1e300`, exit 0), and `--spindle-tol 1e-9` was
+/// planned for and missed (0.0030°, exit 1); a setup's plunge feed of 1e-9 mm/min wrote F0.
+#[test]
+fn numeric_options_and_mutated_documents_are_refused_or_posted() {
+    let w = Work::new();
+    let rows: Vec<Row> = (0..40)
+        .map(|k| {
+            let t = k as f64 / 39.0;
+            let (th, ph) = ((30.0 * (0.3 + 0.7 * t)).to_radians(), (120.0 * t).to_radians());
+            let axis = V3::new(th.sin() * ph.cos(), th.sin() * ph.sin(), th.cos());
+            let tip = P3::new(-20.0 + 40.0 * t, 10.0 * (2.0 * t).sin(), 5.0 * (4.0 * t).cos());
+            Row { path: 0, rapid: k == 0, tip, axis, s: Some(90.0 * t) }
+        })
+        .collect();
+    w.write("s.csv", csv(&rows, 600.0));
+    let plain: Vec<Row> = rows.iter().map(|r| Row { s: None, ..*r }).collect();
+    let nf = csv(&plain, 600.0).replace(",600\n", "\n").replace(",f\n", "\n");
+    w.write("nf.csv", nf);
+    let mut seen = [0usize; 3];
+    let mut check = |args: &[&str]| {
+        let started = std::time::Instant::now();
+        let o = w.run(BIN, args, b"");
+        let took = started.elapsed().as_secs_f64();
+        assert!((0..=2).contains(&o.status), "{args:?}: status {}: {}", o.status, o.stderr);
+        assert!(o.stderr.trim_end().lines().count() <= 1, "{args:?}: {}", o.stderr);
+        assert!(!o.stderr.contains("panicked"), "{args:?}: {}", o.stderr);
+        assert!(took < 20.0, "{args:?}: {took} s");
+        seen[o.status as usize] += 1;
+        o
+    };
+    let values = ["0", "-1", "NaN", "inf", "-inf", "1e-300", "1e300", "1e-9", "1e9"];
+    let options = ["--tol", "--angle-tol", "--spindle-tol", "--feed", "--rotary-radius"];
+    for m in ["paper002-ac.json", "paper000-sixaxis-b.json"] {
+        let m = machine(m);
+        let input = if m.contains("sixaxis") { "s.csv" } else { "nf.csv" };
+        for o in options {
+            for v in values {
+                let arg = format!("{o}={v}");
+                let feed = if o == "--feed" { vec![] } else { vec!["--feed", "500"] };
+                let mut args = vec![input, "-m", &m, &arg, "-o", "o.nc"];
+                args.extend(feed);
+                let out = check(&args);
+                // A value the program cannot be made to is bad input, not a failed check.
+                assert_ne!(out.status, 1, "{arg}: {}", out.stderr);
+                if out.status == 0 {
+                    // What is delivered reads back, and its F words are short.
+                    let nc = w.read("o.nc");
+                    assert!(nc.split_whitespace().all(|word| !word.starts_with('F') || word.len() < 20), "{arg}");
+                    let verify = check(&[input, "-m", &m, "--verify", "o.nc", &arg, "--feed", "500"]);
+                    assert_eq!(verify.status, 0, "{arg}: {}", verify.stderr);
+                }
+            }
+        }
+    }
+    w.write("frame.json", r#"{"xc": 1.0, "yc": 2.0, "za": 50.0}"#);
+    check(&["nf.csv", "-m", &machine("paper002-ac.json"), "--frame", "frame.json", "--feed", "500"]).ok();
+    // Seeded mutations of the documents.
+    let mut seed = 20u64;
+    let mut next = |n: usize| {
+        seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        ((seed >> 33) as usize) % n
+    };
+    let leaves = [
+        serde_json::json!(0),
+        serde_json::json!(-1),
+        serde_json::json!(1e-300),
+        serde_json::json!(1e300),
+        serde_json::json!(-1e300),
+        serde_json::json!(44.99),
+        serde_json::json!(12),
+        serde_json::json!("x"),
+        serde_json::Value::Null,
+        serde_json::json!([]),
+        serde_json::json!([1e300, -1e300]),
+        serde_json::json!({}),
+        serde_json::json!(true),
+    ];
+    let extra = [
+        "/program/decimals",
+        "/program/decimals/linear",
+        "/program/decimals/rotary",
+        "/program/decimals/feed",
+        "/program/decimals/inverse_time_digits",
+        "/program/block_numbers",
+        "/program/units",
+        "/travel",
+        "/travel/x",
+        "/singular_cone",
+        "/singular",
+        "/policy",
+        "/frame",
+        "/frame/za",
+    ];
+    fn pointers(v: &serde_json::Value, at: String, out: &mut Vec<String>) {
+        match v {
+            serde_json::Value::Object(m) => m.iter().for_each(|(k, x)| pointers(x, format!("{at}/{k}"), out)),
+            serde_json::Value::Array(a) => {
+                a.iter().enumerate().for_each(|(i, x)| pointers(x, format!("{at}/{i}"), out))
+            }
+            _ => {}
+        }
+        out.push(at);
+    }
+    for (name, input) in
+        [("paper002-ac.json", "nf.csv"), ("paper000-sixaxis-b.json", "s.csv"), ("head-bc.json", "nf.csv")]
+    {
+        let doc: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(machine(name)).unwrap()).unwrap();
+        let mut at = Vec::new();
+        pointers(&doc, String::new(), &mut at);
+        at.retain(|p| !p.is_empty());
+        at.extend(extra.iter().map(|s| s.to_string()));
+        for _ in 0..60 {
+            let mut d = doc.clone();
+            let p = &at[next(at.len())];
+            let (parent, key) = p.rsplit_once('/').unwrap();
+            let leaf = leaves[next(leaves.len())].clone();
+            let drop = next(8) == 0;
+            // Parents along the way made objects, so that an added field lands.
+            let mut cur = &mut d;
+            for part in parent.split('/').skip(1) {
+                if cur.is_object() && cur.get(part).is_none() {
+                    cur[part] = serde_json::json!({});
+                }
+                cur = match cur {
+                    serde_json::Value::Array(a) => &mut a[part.parse::<usize>().unwrap()],
+                    other => &mut other[part],
+                };
+            }
+            match cur {
+                serde_json::Value::Object(o) if drop => {
+                    o.remove(key);
+                }
+                serde_json::Value::Object(o) => {
+                    o.insert(key.to_string(), leaf);
+                }
+                serde_json::Value::Array(a) => a[key.parse::<usize>().unwrap()] = leaf,
+                _ => {}
+            }
+            w.write("m.json", d.to_string());
+            check(&[input, "-m", "m.json", "--feed", "500", "-o", "o.nc"]);
+            w.write("f.json", serde_json::json!({"xc": 1.0, "yc": leaves[next(leaves.len())], "za": 50.0}).to_string());
+            check(&["nf.csv", "-m", &machine("paper002-ac.json"), "--frame", "f.json", "--feed", "500"]);
+        }
+    }
+    // A setup's plunge feed is written too: 1e-9 mm/min was F0 (exit 1).
+    let jobs = |f: &str| data(&format!("jobs/{f}")).to_str().unwrap().to_string();
+    let mut setup: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(jobs("globe.json")).unwrap()).unwrap();
+    setup["tool"] = jobs("flat-d0.2.json").into();
+    setup["part"]["model"] = jobs("globe-sphere.json").into();
+    setup["plunge"] = serde_json::json!({"feed": 1e-9});
+    w.write("setup.json", setup.to_string());
+    check(&["nf.csv", "-m", &machine("paper002-ac.json"), "--setup", "setup.json", "--feed", "500"])
+        .fails(2, "setup.json (plunge.feed): the plunge feed must be from 0.1 to 1000000, got 1e-9");
+    eprintln!("outcomes (exit 0, 1, 2): {seen:?}");
+    assert!(seen[0] > 20 && seen[2] > 100, "{seen:?}");
+}

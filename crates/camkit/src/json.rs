@@ -3,7 +3,9 @@
 
 use crate::error::{Error, Location, Result};
 use crate::io::Input;
+use serde::Serialize;
 use serde::de::DeserializeOwned;
+use serde_json::Value;
 
 /// Parses a JSON document of type `T` from an input.
 pub fn from_input<T: DeserializeOwned>(input: &Input) -> Result<T> {
@@ -31,6 +33,51 @@ pub fn from_input<T: DeserializeOwned>(input: &Input) -> Result<T> {
             .at(Location::file(&input.name).line(e.line() as u64).column(e.column() as u64))
     })?;
     Ok(value)
+}
+
+/// Parses a document (a JSON object) of type `T` from an input as [`from_input`] does, and checks
+/// that it and every structure inside it was written as a JSON object: serde reads a structure
+/// from an array too, by position (`[1, 2, 3]` as a frame's `xc, yc, za`), which silently takes
+/// a misplaced list for a document. A document that is not an object is refused at its first
+/// character (line:column); inside it, the shape is compared with `T` written back as JSON, and
+/// an array where `T` has an object is refused naming its JSON path.
+pub fn document<T: DeserializeOwned + Serialize>(input: &Input) -> Result<T> {
+    let text = input.text()?;
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+    let at = text.len() - text.trim_start().len();
+    if let Some(first) = text[at..].chars().next().filter(|&c| c != '{') {
+        let line = text[..at].matches('\n').count() + 1;
+        let column = text[..at].chars().rev().take_while(|&c| c != '\n').count() + 1;
+        let found = match first {
+            '[' => "an array",
+            '"' => "a string",
+            _ => "a value",
+        };
+        return Err(Error::input(format!("expected a JSON object, found {found}"))
+            .at(Location::file(&input.name).line(line as u64).column(column as u64)));
+    }
+    let value: T = from_input(input)?;
+    let found: Value = from_input(input)?;
+    let shape = serde_json::to_value(&value).map_err(|e| Error::runtime(e.to_string()))?;
+    if let Some(path) = array_for_object(&found, &shape, String::new()) {
+        return Err(Error::input("expected a JSON object, found an array").at(Location::file(&input.name).field(path)));
+    }
+    Ok(value)
+}
+
+/// JSON path of the first array in `found` where `shape` has an object.
+fn array_for_object(found: &Value, shape: &Value, path: String) -> Option<String> {
+    match (found, shape) {
+        (Value::Array(_), Value::Object(_)) => Some(path),
+        (Value::Object(f), Value::Object(s)) => f.iter().find_map(|(k, v)| {
+            let sub = if path.is_empty() { k.clone() } else { format!("{path}.{k}") };
+            s.get(k).and_then(|sv| array_for_object(v, sv, sub))
+        }),
+        (Value::Array(f), Value::Array(s)) => {
+            f.iter().zip(s).enumerate().find_map(|(i, (v, sv))| array_for_object(v, sv, format!("{path}[{i}]")))
+        }
+        _ => None,
+    }
 }
 
 /// Reads and parses a JSON document from a path (or `-`).
@@ -76,5 +123,37 @@ mod tests {
         assert!(e.to_string().contains("(items[0]): missing field `radius`"), "{e}");
         assert!(parse("").unwrap_err().to_string().contains("empty input"));
         assert_eq!(parse("{\"items\": []} x").unwrap_err().exit_status(), 2);
+    }
+
+    #[derive(Debug, Deserialize, Serialize)]
+    #[serde(deny_unknown_fields)]
+    struct Frame {
+        xc: f64,
+        yc: f64,
+        inner: Option<Inner>,
+        list: Vec<Inner>,
+    }
+
+    #[derive(Debug, Deserialize, Serialize)]
+    #[serde(deny_unknown_fields)]
+    struct Inner {
+        a: f64,
+    }
+
+    /// serde reads a structure from an array by position; a document refuses it, naming where.
+    #[test]
+    fn documents_are_objects() {
+        let doc = |text: &str| document::<Frame>(&Input { name: "f.json".into(), data: text.as_bytes().to_vec() });
+        assert!(doc(r#"{"xc": 1, "yc": 2, "inner": {"a": 3}, "list": [{"a": 1}]}"#).is_ok());
+        assert_eq!(
+            doc("\n  [1, 2, null, []]").unwrap_err().to_string(),
+            "f.json:2:3: expected a JSON object, found an array"
+        );
+        assert_eq!(doc("\u{feff}3").unwrap_err().to_string(), "f.json:1:1: expected a JSON object, found a value");
+        assert!(doc(" \n").unwrap_err().to_string().contains("empty input"));
+        let e = doc(r#"{"xc": 1, "yc": 2, "inner": [3], "list": []}"#).unwrap_err();
+        assert_eq!(e.to_string(), "f.json (inner): expected a JSON object, found an array");
+        let e = doc(r#"{"xc": 1, "yc": 2, "inner": null, "list": [{"a": 1}, [2]]}"#).unwrap_err();
+        assert_eq!(e.to_string(), "f.json (list[1]): expected a JSON object, found an array");
     }
 }

@@ -99,6 +99,12 @@ fn main() -> ExitCode {
     cli::run("post-6axis", || run(Args::parse()))
 }
 
+/// A number as typed for a message: plain, or in exponent form when plain would run to dozens of
+/// digits.
+fn short(v: f64) -> String {
+    if v != 0.0 && !(1e-6..1e9).contains(&v.abs()) { format!("{v:e}") } else { v.to_string() }
+}
+
 fn load_machine(args: &Args) -> Result<(Machine, Chain)> {
     let (machine, mut chain) = Machine::read(&args.machine)?;
     if let Some(path) = &args.frame {
@@ -124,18 +130,33 @@ fn with_job(mut machine: Machine, job: &Job) -> Result<Machine> {
 fn run(args: Args) -> Result<()> {
     let started = Instant::now();
     let job = args.setup.as_deref().map(Setup::read).transpose()?;
+    let (machine, chain) = load_machine(&args)?;
+    let within = |v: f64, (lo, hi): (f64, f64), what: &str| {
+        positive(v, what).and_then(|v| match v {
+            v if (lo..=hi).contains(&v) => Ok(v),
+            _ => Err(Error::input(format!("{what} must be from {lo} to {hi}, got {}", short(v)))),
+        })
+    };
+    let feed_range = post_6axis::feed_range(&machine);
     let settings = Settings {
         tol: positive(args.tol, "--tol")?,
         angle_tol: positive(args.angle_tol, "--angle-tol")?,
         spindle_tol: positive(args.spindle_tol, "--spindle-tol")?,
-        rotary_radius: positive(args.rotary_radius, "--rotary-radius")?,
-        feed: args
-            .feed
-            .map(|f| positive(f, "--feed"))
-            .transpose()?
-            .or(job.as_ref().and_then(|j| j.tool.cutting_feed())),
+        rotary_radius: within(args.rotary_radius, (0.0, post_6axis::MAX_ROTARY_RADIUS), "--rotary-radius")?,
+        feed: match args.feed {
+            Some(f) => Some(within(f, feed_range, "--feed")?),
+            None => match job.as_ref().and_then(|j| Some((j, j.tool.cutting_feed()?))) {
+                Some((j, f)) => Some(
+                    within(f, feed_range, "the tool's cutting feed").map_err(|e| e.at(Location::file(&j.tool_file)))?,
+                ),
+                None => None,
+            },
+        },
     };
-    let (machine, chain) = load_machine(&args)?;
+    if let Some(j) = &job {
+        // The setup's plunge feed (or the tool's) is written too: F0 below the range.
+        within(j.plunge_feed, feed_range, "the plunge feed").map_err(|e| j.error("plunge.feed", e.message))?;
+    }
     let machine = match &job {
         Some(j) => with_job(machine, j)?,
         None => machine,
@@ -183,6 +204,11 @@ fn run(args: Args) -> Result<()> {
         let program = read_axes(&nc_input.name, nc_input.text()?)?;
         let reading = readback::Reading::new(&machine, &chain);
         let poses = readback::poses(&program, &reading);
+        if poses.iter().all(Option::is_none) {
+            // Nothing to compare: every row would be "missed" by an infinite distance.
+            return Err(Error::input("the program has no motion blocks (in workpiece coordinates, every axis known)")
+                .at(Location::file(&nc_input.name)));
+        }
         let d = readback::verify(&rows, &poses, &reading, 32, settings.tol);
         deviation_keys(&mut report, &d);
         report.set("rows", rows.len()).set("tol_mm", settings.tol).set("angle_tol_deg", settings.angle_tol);

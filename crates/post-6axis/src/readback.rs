@@ -379,11 +379,20 @@ fn nearest_on_path(p: &P3, path: &[P3], hint: Option<usize>, far: f64) -> (usize
     best
 }
 
-/// Angle (radians) of the tool axis from the CL axis where the tool is: over the CL points within
-/// `tol` of the tip on segment `seg` (at distance `d`) and the segments it shares a row with, the
-/// least angle to the axis arc there. A short segment that turns the axis with the tip (nearly)
-/// still, or a pass closing on its start, leaves the tip's nearest parameter undefined: every
-/// axis along the turn is then where the tool may be, as planning measures it.
+/// Segments [`axis_deviation`] looks at each way from where the previous sample's axis matched.
+const AXIS_WALK: usize = 64;
+
+/// Angle (radians) of the tool axis from the CL axis where the tool is, and the segment it is
+/// nearest on: over the CL points within `tol` of the tip on segment `seg` (at distance `d`) and
+/// its neighbours, and on the run of segments joined to `from` (where the previous sample's axis
+/// matched; `seg` without one) that stay within `tol` of the tip, up to [`AXIS_WALK`] each way,
+/// the least angle to the axis arc there. A short segment that turns the axis with the tip
+/// (nearly) still, or a pass closing on its start, leaves the tip's nearest parameter undefined:
+/// every axis along the turn is then where the tool may be, as planning measures it. A turn on
+/// the spot is a run of zero-length segments all as near as the segment leaving it, and the tip's
+/// nearest may be any of them (it once took the one leaving a 20° turn and measured the turn's
+/// first block against the turn's last 10°): the samples follow the turn in order from `from`,
+/// a bounded walk however many rows the turn has.
 #[allow(clippy::too_many_arguments)]
 fn axis_deviation(
     tip: &P3,
@@ -391,11 +400,10 @@ fn axis_deviation(
     cl: &[Cl],
     segs: &[(usize, usize)],
     paths: &[ClPath],
-    seg: usize,
-    d: f64,
+    (seg, d): (usize, f64),
+    from: Option<usize>,
     tol: f64,
-) -> f64 {
-    let (i0, i1) = segs[seg];
+) -> (f64, usize) {
     let at = |k: usize, dk: f64| {
         let (a, b) = segs[k];
         let len = (cl[b].tip - cl[a].tip).norm();
@@ -404,13 +412,34 @@ fn axis_deviation(
         let (lo, hi) = ((u - half).max(0.0), (u + half).min(1.0));
         vector_arc(axis, &slerp(&cl[a].axis, &cl[b].axis, lo), &slerp(&cl[a].axis, &cl[b].axis, hi))
     };
-    let mut best = at(seg, d);
-    let neighbours =
-        [seg.checked_sub(1).filter(|&k| segs[k].1 == i0), Some(seg + 1).filter(|&k| k < segs.len() && segs[k].0 == i1)];
-    for k in neighbours.into_iter().flatten() {
-        let dk = paths[k].distance(tip);
-        if dk <= tol {
-            best = best.min(at(k, dk));
+    let near = |k: usize| Some(paths[k].distance(tip)).filter(|&dk| dk <= tol);
+    let mut best = (at(seg, d), seg);
+    let mut take = |k: usize, dk: f64| {
+        let a = at(k, dk);
+        if a < best.0 {
+            best = (a, k);
+        }
+    };
+    let back = |k: usize| k.checked_sub(1).filter(|&p| segs[p].1 == segs[k].0);
+    let ahead = |k: usize| Some(k + 1).filter(|&n| n < segs.len() && segs[n].0 == segs[k].1);
+    for k in [back(seg), ahead(seg)].into_iter().flatten() {
+        if let Some(dk) = near(k) {
+            take(k, dk);
+        }
+    }
+    let centre = match from.filter(|&f| f != seg).and_then(|f| Some((f, near(f)?))) {
+        Some((f, df)) => {
+            take(f, df);
+            f
+        }
+        None => seg,
+    };
+    for step in [&back as &dyn Fn(usize) -> Option<usize>, &ahead] {
+        let mut k = centre;
+        for _ in 0..AXIS_WALK {
+            let Some((next, dk)) = step(k).and_then(|n| Some((n, near(n)?))) else { break };
+            take(next, dk);
+            k = next;
         }
     }
     best
@@ -432,6 +461,7 @@ fn check_blocks(
 ) -> (Deviation, Vec<(usize, f64)>) {
     let mut dev = Deviation::default();
     let mut by_row: Vec<(usize, f64)> = Vec::new();
+    let mut axis_hint = None;
     for &(a, b) in blocks {
         dev.blocks += 1;
         let samples = samples_of(a, b, samples_per_block);
@@ -450,7 +480,9 @@ fn check_blocks(
                 dev.tip = d;
                 dev.tip_line = b.line;
             }
-            let da = axis_deviation(&tip, &axis, cl, segs, paths, seg, d, far).to_degrees();
+            let (da, matched) = axis_deviation(&tip, &axis, cl, segs, paths, (seg, d), axis_hint, far);
+            axis_hint = Some(matched);
+            let da = da.to_degrees();
             let (i0, i1) = segs[seg];
             let u = param(&tip, &cl[i0].tip, &cl[i1].tip);
             if da > dev.axis_deg {

@@ -520,7 +520,7 @@ impl Machine {
     /// Reads a machine document and builds its chain; errors name the file and JSON path.
     pub fn read(path: &str) -> Result<(Machine, Chain)> {
         let input = crate::io::Input::open(path)?;
-        let m: Machine = crate::json::from_input(&input)?;
+        let m: Machine = crate::json::document(&input)?;
         let chain = m.kinematics(&input.name)?;
         Ok((m, chain))
     }

@@ -415,7 +415,7 @@ fn check_knots(knots: Option<&[f64]>, n: usize, p: usize, path: &str, file: &str
 impl ModelDoc {
     /// Reads a model document (not its STL files) and validates it.
     pub fn from_input(input: &crate::io::Input) -> Result<ModelDoc> {
-        let doc: ModelDoc = crate::json::from_input(input)?;
+        let doc: ModelDoc = crate::json::document(input)?;
         doc.validate(&input.name)?;
         Ok(doc)
     }

@@ -260,7 +260,7 @@ impl Setup {
     /// Reads a setup document and everything it names; errors name the file and the JSON path.
     pub fn read(path: &str) -> Result<Job> {
         let input = crate::io::Input::open(path)?;
-        let setup: Setup = crate::json::from_input(&input)?;
+        let setup: Setup = crate::json::document(&input)?;
         let base = match Path::new(path).parent() {
             Some(p) if path != "-" && !p.as_os_str().is_empty() => p.to_path_buf(),
             _ => PathBuf::from("."),

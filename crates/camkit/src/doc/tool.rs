@@ -154,7 +154,7 @@ impl Tool {
     /// Reads and validates a tool document.
     pub fn read(path: &str) -> Result<Tool> {
         let input = crate::io::Input::open(path)?;
-        let tool: Tool = crate::json::from_input(&input)?;
+        let tool: Tool = crate::json::document(&input)?;
         tool.validate(&input.name)?;
         Ok(tool)
     }
