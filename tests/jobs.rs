@@ -4,6 +4,7 @@
 //! descent from the feed moves before it).
 
 use e2e::{Work, data};
+use std::process::Command;
 
 const BIN: &str = "post-6axis";
 
@@ -512,4 +513,33 @@ fn the_dxf_pocket_with_two_islands_posts_with_safe_rapids() {
             assert!(part(x, y) >= R - 1e-3, "line {}: ({x}, {y}) is {} from the part", b.line, part(x, y));
         }
     }
+}
+
+/// The check against a 3-D part shows a progress bar on a terminal (run under `script`, which
+/// gives the program one) and nothing in a pipe.
+#[test]
+fn the_part_check_shows_progress_on_a_terminal_only() {
+    use camkit::geom::P3;
+    let w = job();
+    let floor = [
+        [P3::new(-10.0, -10.0, -13.0), P3::new(110.0, -10.0, -13.0), P3::new(110.0, 70.0, -13.0)],
+        [P3::new(-10.0, -10.0, -13.0), P3::new(110.0, 70.0, -13.0), P3::new(-10.0, 70.0, -13.0)],
+    ];
+    w.write("floor.stl", camkit::model::mesh::binary_stl(&floor));
+    w.write("solid.json", SETUP.replace(r#""contours": "pocket.csv", "floor": -12"#, r#""model": "floor.stl""#));
+    let m = machine();
+    let args = ["passes.csv", "--machine", &m, "--setup", "solid.json", "-o", "p.ngc"];
+    let piped = w.run(BIN, &args, b"");
+    piped.ok();
+    assert!(!piped.stderr.contains("checking against the part"), "{}", piped.stderr);
+    if Command::new("script").arg("--version").output().is_err() {
+        return;
+    }
+    let line = std::iter::once(e2e::bin(BIN).display().to_string())
+        .chain(args.iter().map(|a| a.to_string()))
+        .collect::<Vec<_>>()
+        .join(" ");
+    let tty = Command::new("script").args(["-qec", &line, "/dev/null"]).current_dir(w.path("")).output().unwrap();
+    assert!(tty.status.success(), "{tty:?}");
+    assert!(String::from_utf8_lossy(&tty.stdout).contains("checking against the part"), "{tty:?}");
 }

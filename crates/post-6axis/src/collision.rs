@@ -269,7 +269,13 @@ fn placement(r: &Reading, q: &camkit::kinematics::Joints, sigma: Option<f64>) ->
 impl Check<'_> {
     /// Every block against the 3-D part, in parallel (the part does not change): exact casts
     /// where the body and the block allow them, samples every `step` mm otherwise.
-    pub fn run_solid(&self, poses: &[Option<NcPose>], r: &Reading, step: f64) -> SolidOutcome {
+    pub fn run_solid(
+        &self,
+        poses: &[Option<NcPose>],
+        r: &Reading,
+        step: f64,
+        tick: &(dyn Fn() + Sync),
+    ) -> SolidOutcome {
         let Some((solid, body)) = self.solid else { return SolidOutcome::default() };
         let job = self.job;
         let limit = job.allowance - job.tolerance;
@@ -284,8 +290,13 @@ impl Check<'_> {
             }
             prev = pose.as_ref();
         }
-        let each: Vec<BlockSolid> =
-            pairs.par_iter().map(|&(a, b)| block_solid(solid, body, r, a, b, limit, reach, step)).collect();
+        let each: Vec<BlockSolid> = pairs
+            .par_iter()
+            .map(|&(a, b)| {
+                tick();
+                block_solid(solid, body, r, a, b, limit, reach, step)
+            })
+            .collect();
         let mut o = SolidOutcome::default();
         for b in each {
             least(if b.rapid { &mut o.rapid } else { &mut o.feed }, b.least, b.line);

@@ -341,7 +341,10 @@ fn collide(
     let mut o = check.run(&poses, &reading).map_err(Error::runtime)?;
     report.set("material_check_seconds", started.elapsed().as_secs_f64());
     let started = Instant::now();
-    let so = check.run_solid(&poses, &reading, job.resolution);
+    let progress =
+        cli::Progress::new(if solid.is_some() { poses.len() as u64 } else { 0 }, "checking against the part");
+    let so = check.run_solid(&poses, &reading, job.resolution, &|| progress.inc(1));
+    progress.finish();
     report.set("part_check_seconds", started.elapsed().as_secs_f64());
     let low = |a: Option<(f64, u32)>, b: Option<(f64, u32)>| match (a, b) {
         (Some(x), Some(y)) => Some(if y.0 < x.0 { y } else { x }),
