@@ -17,6 +17,7 @@ use crate::doc::tool::{Tool, ToolKind};
 use crate::geom::{P3, V3};
 use crate::model::analytic::Analytic;
 use crate::model::{Aabb, Geometry, Model};
+use parry3d_f64::bounding_volume::BoundingVolume;
 use parry3d_f64::math::{Pose, Vector};
 use parry3d_f64::query::{self, ShapeCastOptions};
 use parry3d_f64::shape::{SharedShape, TriMeshFlags};
@@ -73,6 +74,16 @@ impl Piece {
             PieceKind::Wedge => unreachable!("wedges are built with their corners"),
         };
         Piece { pose, shape, kind, holder: false }
+    }
+
+    /// The slab along the tool axis that holds the piece and the largest distance of its points
+    /// from the axis: (lowest height, highest height, radius); `None` for a wedge.
+    fn span(&self) -> Option<(f64, f64, f64)> {
+        match self.kind {
+            PieceKind::Capsule { from, to, radius } => Some((from - radius, to.max(from) + radius, radius)),
+            PieceKind::Cylinder { from, to, radius, .. } => Some((from, to, radius)),
+            PieceKind::Wedge => None,
+        }
     }
 
     /// The piece shrunk by `e` (every surface moved `e` inwards); `None` if nothing is left.
@@ -352,6 +363,50 @@ fn mesh_piece(name: &str, corners: impl Iterator<Item = [P3; 3]>, solid_inside: 
     Ok(PartPiece { pose: Pose::identity(), shape, closed_mesh: false })
 }
 
+/// Signed clearance (at most `reach`) between a body piece round the tool axis (at `pos`; within
+/// heights `lo..hi` of the axis from the tip of `at` and `radius` of it) and a triangle mesh: the
+/// same as parry's contact of the piece with the whole mesh, but triangles that the piece's slab
+/// or its cylinder round the axis separates from it by more than `reach` (exact, cheap tests) are
+/// not handed to GJK/EPA — under a tool standing on a surface most of them are.
+fn mesh_clearance(
+    part: &PartPiece,
+    mesh: &parry3d_f64::shape::TriMesh,
+    piece: &Piece,
+    pos: &Pose,
+    at: &Placement,
+    (lo, hi, radius): (f64, f64, f64),
+    reach: f64,
+) -> f64 {
+    let (tip, axis) = (pt(&at.tip), v(&at.axis));
+    let reach_out = reach.max(0.0);
+    // Distance from the axis line of a point (the line, not the segment: a lower bound).
+    let off_axis = |p: Vector| {
+        let d = p - tip;
+        (d - axis * d.dot(axis)).length()
+    };
+    let mut best = reach;
+    // The piece's box in the mesh's frame, grown by the reach.
+    let query = piece.shape.compute_aabb(&(part.pose.inverse() * pos)).loosened(reach_out);
+    for i in mesh.bvh().intersect_aabb(&query) {
+        let t = mesh.triangle(i);
+        let corners = [part.pose * t.a, part.pose * t.b, part.pose * t.c];
+        let h = corners.map(|c| (c - tip).dot(axis));
+        if h.iter().all(|&x| x < lo - reach_out) || h.iter().all(|&x| x > hi + reach_out) {
+            continue;
+        }
+        let centre = (corners[0] + corners[1] + corners[2]) / 3.0;
+        let spread = corners.iter().map(|c| (*c - centre).length()).fold(0.0, f64::max);
+        if off_axis(centre) - spread > radius + reach_out {
+            continue;
+        }
+        let tri = parry3d_f64::shape::Triangle::new(corners[0], corners[1], corners[2]);
+        if let Ok(Some(c)) = query::contact(&Pose::identity(), &tri, pos, piece.shape.as_ref(), reach) {
+            best = best.min(c.dist);
+        }
+    }
+    best
+}
+
 impl Solid {
     /// The part of a model: meshes and patches as triangle meshes (patches within `chord` mm),
     /// spheres as balls and planes as half-spaces (their outward normals flipped as the model
@@ -494,6 +549,10 @@ impl Solid {
         for part in &self.pieces {
             for piece in &body.pieces {
                 let pos = pose * piece.pose;
+                if let (Some(mesh), Some((lo, hi, radius))) = (part.shape.as_trimesh(), piece.span()) {
+                    best = best.min(mesh_clearance(part, mesh, piece, &pos, at, (lo, hi, radius), reach));
+                    continue;
+                }
                 // The part first: parry 0.31 gives a wrong sign for a shape against a half-space
                 // given second (right with it first).
                 if let Ok(Some(c)) = query::contact(&part.pose, part.shape.as_ref(), &pos, piece.shape.as_ref(), reach)
