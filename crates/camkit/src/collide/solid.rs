@@ -387,7 +387,27 @@ fn mesh_clearance(
     let mut best = reach;
     // The piece's box in the mesh's frame, grown by the reach.
     let query = piece.shape.compute_aabb(&(part.pose.inverse() * pos)).loosened(reach_out);
-    for i in mesh.bvh().intersect_aabb(&query) {
+    // Whole subtrees go the same way: a node's box outside the slab, or farther from the axis
+    // than the radius, holds no triangle that could touch.
+    let (axis_abs, local_tip, local_axis) = {
+        let inv = part.pose.inverse();
+        let a = inv.rotation * axis;
+        (a.abs(), inv * tip, a)
+    };
+    let keep = |node: &parry3d_f64::partitioning::BvhNode| {
+        let b = node.aabb();
+        if !b.intersects(&query) {
+            return false;
+        }
+        let (c, e) = (b.center(), b.half_extents());
+        let (h, spread) = ((c - local_tip).dot(local_axis), e.dot(axis_abs));
+        if h + spread < lo - reach_out || h - spread > hi + reach_out {
+            return false;
+        }
+        let d = c - local_tip;
+        (d - local_axis * d.dot(local_axis)).length() - e.length() <= radius + reach_out
+    };
+    for i in mesh.bvh().leaves(keep) {
         let t = mesh.triangle(i);
         let corners = [part.pose * t.a, part.pose * t.b, part.pose * t.c];
         let h = corners.map(|c| (c - tip).dot(axis));
