@@ -4,6 +4,7 @@ use camkit::geom::{P3, V3};
 use camkit::io::Input;
 use camkit::model::Model;
 use criterion::{Criterion, criterion_group, criterion_main};
+use tool_attitude::gouge::Part;
 use tool_attitude::{Contact, Setup, Shape, attitude};
 
 fn contacts() -> Vec<Contact> {
@@ -36,7 +37,11 @@ fn bench(c: &mut Criterion) {
     };
     let doc = r#"{"surfaces": [{"type": "sphere", "centre": [0, 0, -500], "radius": 500}]}"#;
     let model = Model::load(&Input { name: "sphere.json".into(), data: doc.as_bytes().to_vec() }).unwrap();
-    for (name, m) in [("cylinder_1000_rows", None), ("cylinder_1000_rows_gouge_check", Some(&model))] {
+    let tool = r#"{"kind": "cylindrical-nonrotating", "radius": 12.5}"#;
+    let tool: camkit::doc::Tool =
+        camkit::json::from_input(&Input { name: "tool.json".into(), data: tool.as_bytes().to_vec() }).unwrap();
+    let part = Part::new(model, &tool, 50.0, 2.5e-4, true).unwrap();
+    for (name, m) in [("cylinder_1000_rows", None), ("cylinder_1000_rows_gouge_check", Some(&part))] {
         c.bench_function(name, |b| {
             b.iter(|| cs.iter().map(|ct| attitude(&setup, ct, m).unwrap().pose.tip.x).sum::<f64>())
         });

@@ -1,64 +1,66 @@
-//! Gouge checks: the tool body as probe points that must each stay a clearance outside the
-//! model (signed distance from the nearest-point query), and the search for the tilt nearest the
-//! requested one, inside the allowed range, at which no probe cuts in.
+//! Gouge checks: the whole tool body as an exact solid against the part (camkit's
+//! [`Solid::clearance`]: every overlap of the body with the model is found, not samples of it),
+//! the flat-type tool's flank probes, and the search for the tilt nearest the requested one,
+//! inside the allowed range, at which the body does not cut in.
 
-use camkit::geom::{P3, V3};
+use crate::pose::Pose;
+use camkit::collide::solid::{Body, Placement, Solid};
+use camkit::doc::Tool;
+use camkit::geom::P3;
 use camkit::model::Model;
 
-/// A point of the tool body and how far outside the model it must stay (mm).
+/// The part a pose is checked against: the model, and for a tool with a body (cylinder, ball,
+/// flat end mill) that body and the model as a solid.
+pub struct Part {
+    /// The model (nearest-point queries: the flat-type correction and its flank probes).
+    pub model: Model,
+    body: Option<(Solid, Body)>,
+}
+
+impl Part {
+    /// The part for `tool` whose body reaches `length` above its tip; with `solid`, the model as
+    /// a solid (B-spline patches, bounded flipped cylinders, cones and tori as triangles within
+    /// `chord` mm; see [`Solid::of_any`]). An error names the surface the solid cannot take.
+    pub fn new(model: Model, tool: &Tool, length: f64, chord: f64, solid: bool) -> Result<Part, String> {
+        let body = if solid {
+            let body = Body::of(&Tool { length: Some(length), ..tool.clone() });
+            Some((Solid::of_any(&model, chord)?, body))
+        } else {
+            None
+        };
+        Ok(Part { model, body })
+    }
+
+    /// Largest distance (mm) between a tessellated surface and its triangles: each penetration
+    /// is exact against the triangles, so within this of the surface's own (0: exact surfaces).
+    pub fn chord_error(&self) -> f64 {
+        self.body.as_ref().map_or(0.0, |(s, _)| s.chord_error())
+    }
+
+    /// How deep the tool body at `pose` cuts into the part (mm, 0 when clear): the penetration
+    /// depth of the body into the solid (for a mesh, the deepest overlap with one of its
+    /// triangles, or the tip's depth inside a closed mesh). 0 for a part without a body.
+    pub fn penetration(&self, pose: &Pose) -> f64 {
+        self.body.as_ref().map_or(0.0, |(solid, body)| {
+            let at = Placement { tip: pose.tip, axis: pose.axis, edge: pose.edge };
+            (-solid.clearance(body, &at, 0.0)).max(0.0)
+        })
+    }
+}
+
+/// A point of the flat-type tool's flanks and how far outside the model it must stay (mm).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Probe {
     /// The point.
     pub point: P3,
-    /// Required signed distance to the model (0 for a body surface point, r for a point on an
-    /// axis or edge that the body surrounds by r).
+    /// Required signed distance to the model (the stylus radius: the edge is the stylus's
+    /// offset of the surface).
     pub clearance: f64,
-}
-
-/// Points round a circle of `radius` about `centre` in the plane normal to unit `axis`, the
-/// first in the direction `u` (unit, perpendicular to the axis).
-fn ring(out: &mut Vec<Probe>, centre: &P3, axis: &V3, u: &V3, radius: f64, count: usize, clearance: f64) {
-    let v = axis.cross(u);
-    for k in 0..count {
-        let (s, c) = (std::f64::consts::TAU * k as f64 / count as f64).sin_cos();
-        out.push(Probe { point: centre + (u * c + v * s) * radius, clearance });
-    }
-}
-
-/// Probes of a flat-bottomed cylinder of `radius` and `length` standing on its bottom-face
-/// centre `tip` along `axis`: the rim (96 points, the first towards `edge`, so the cutting point
-/// and the rim point opposite it, where a tilted tool gouges first, are probed exactly), three
-/// inner rings, the centre, and rings up the side. Used for the cylindrical non-rotating tool
-/// (`edge` = the edge direction) and the flat end mill (`None`: any direction).
-pub fn cylinder_probes(tip: &P3, axis: &V3, edge: Option<&V3>, radius: f64, length: f64) -> Vec<Probe> {
-    let u =
-        edge.copied().unwrap_or_else(|| axis.cross(&if axis.x.abs() < 0.9 { V3::x() } else { V3::y() }).normalize());
-    let mut out = Vec::with_capacity(400);
-    ring(&mut out, tip, axis, &u, radius, 96, 0.0);
-    for k in 1..4 {
-        ring(&mut out, tip, axis, &u, radius * k as f64 / 4.0, 48, 0.0);
-    }
-    out.push(Probe { point: *tip, clearance: 0.0 });
-    let levels = 4;
-    for k in 1..=levels {
-        ring(&mut out, &(tip + axis * (length * k as f64 / levels as f64)), axis, &u, radius, 48, 0.0);
-    }
-    out
-}
-
-/// Probes of a ball end mill: points on the axis from the ball centre up `length`, each to stay
-/// `radius` away (the capsule round the axis holds the ball and the shank).
-pub fn ball_probes(tip: &P3, axis: &V3, radius: f64, length: f64) -> Vec<Probe> {
-    let centre = tip + axis * radius;
-    let count = 16;
-    (0..=count)
-        .map(|k| Probe { point: centre + axis * (length * k as f64 / count as f64), clearance: radius })
-        .collect()
 }
 
 /// Probes along the flat-type tool's two flanks from the tip, each to stay the stylus radius `r`
 /// away (the edge is the stylus's offset of the surface).
-pub fn flank_probes(tip: &P3, flanks: (V3, V3), length: f64, r: f64) -> Vec<Probe> {
+pub fn flank_probes(tip: &P3, flanks: (camkit::geom::V3, camkit::geom::V3), length: f64, r: f64) -> Vec<Probe> {
     let count = 16;
     let mut out = Vec::with_capacity(2 * count);
     for f in [flanks.0, flanks.1] {
@@ -132,6 +134,80 @@ pub const ADJUST_ANGLE_TOL: f64 = 1e-7;
 #[cfg(test)]
 mod tests {
     use super::*;
+    use camkit::geom::V3;
+    use camkit::model::analytic::Analytic;
+    use camkit::model::mesh::Mesh;
+    use camkit::model::{Geometry, Surface};
+    use proptest::prelude::*;
+
+    /// A closed prism of `n` sides (radius `r` to its edges) round the line through `b` along the
+    /// horizontal unit `d`, 400 mm long, faces turned outwards.
+    fn prism(b: P3, d: V3, r: f64, n: usize) -> Vec<[P3; 3]> {
+        let (u, w) = (V3::z().cross(&d), V3::z());
+        let ring = |t: f64| -> Vec<P3> {
+            (0..n)
+                .map(|k| {
+                    let a = std::f64::consts::TAU * k as f64 / n as f64;
+                    b + d * t + (u * a.cos() + w * a.sin()) * r
+                })
+                .collect()
+        };
+        let (p, q) = (ring(-200.0), ring(200.0));
+        let (cp, cq) = (b - d * 200.0, b + d * 200.0);
+        let mut tris = Vec::new();
+        for k in 0..n {
+            let m = (k + 1) % n;
+            tris.extend([[p[k], q[m], q[k]], [p[k], p[m], q[m]], [cp, p[m], p[k]], [cq, q[k], q[m]]]);
+        }
+        tris
+    }
+
+    /// Parameter along the segment `a + s·e` (s in 0..len, unit e) of its nearest point to the
+    /// line through `b` along unit `d`, unclamped, and the distance there.
+    fn segment_line(a: &P3, e: &V3, b: &P3, d: &V3) -> (f64, f64) {
+        let w = a - b;
+        let (k, c, f) = (e.dot(d), e.dot(&w), d.dot(&w));
+        let s = (k * f - c) / (1.0 - k * k);
+        let q = a + e * s;
+        let u = d.dot(&(q - b));
+        (s, (q - (b + d * u)).norm())
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig { cases: 64, ..ProptestConfig::default() })]
+
+        /// A thin rod (a 64-sided prism of radius 0.5) at a random height, angle and depth
+        /// beside the φ25 cylinder standing on a floor at a random tilt: the body check finds it
+        /// at the depth an independent closed form gives (segment-to-line distance from the
+        /// tool's axis to the rod's, less the radii), within the prism's sagitta.
+        #[test]
+        fn thin_rods_beside_the_body_are_found(
+            zr in 1.0f64..34.0, depth in -0.2f64..0.45, phi in -0.5f64..0.5, tilt in -20.0f64..0.0, x0 in -15.0f64..15.0,
+        ) {
+            let (big, r, n) = (12.5, 0.5, 64);
+            let pose = crate::pose::cylinder(&P3::origin(), &V3::z(), &V3::x(), big, tilt.to_radians());
+            let d = V3::new(phi.cos(), phi.sin(), 0.0);
+            // The rod's axis `big + r − depth` from the tool's axis at height zr, across it.
+            let on_axis = pose.tip + pose.axis * ((zr - pose.tip.z) / pose.axis.z);
+            let across = V3::z().cross(&d);
+            let b = on_axis + across * (big + r - depth) + d * x0;
+            let (s, dist) = segment_line(&pose.tip, &pose.axis, &b, &d);
+            prop_assume!(s > 1.0 && s < 39.0);
+            let exact = big + r - dist;
+            let model = Model { surfaces: vec![
+                Surface::new("floor".into(), Geometry::Analytic(Analytic::Plane { point: P3::origin(), normal: V3::z() }), None, false),
+                Surface::new("rod".into(), Geometry::Mesh(Mesh::new(&prism(b, d, r, n)).unwrap()), None, false),
+            ] };
+            let tool: Tool = camkit::json::from_input(&camkit::io::Input {
+                name: "t.json".into(),
+                data: br#"{"kind": "cylindrical-nonrotating", "radius": 12.5}"#.to_vec(),
+            }).unwrap();
+            let part = Part::new(model, &tool, 40.0, 1e-4, true).unwrap();
+            let got = part.penetration(&pose);
+            let sagitta = r * (1.0 - (std::f64::consts::PI / n as f64).cos());
+            prop_assert!((got - exact.max(0.0)).abs() <= sagitta + 1e-6, "gouge {got}, exact {exact}");
+        }
+    }
 
     #[test]
     fn adjust_finds_the_nearest_clear_tilt() {

@@ -5,8 +5,8 @@
 //! whole tool body against the model.
 //!
 //! [`pose`] holds the closed-form poses, [`edge`] eq. (1), [`flat_type`] the control-stylus
-//! correction, [`gouge`] the body probes and the tilt search; [`attitude`] puts them together
-//! for one row.
+//! correction, [`gouge`] the body check against the part and the tilt search; [`attitude`] puts
+//! them together for one row.
 
 pub mod edge;
 pub mod flat_type;
@@ -14,7 +14,7 @@ pub mod gouge;
 pub mod pose;
 
 use camkit::geom::{P3, V3};
-use camkit::model::Model;
+use gouge::Part;
 use pose::Pose;
 
 /// The tool, as `tool-attitude` uses it.
@@ -57,7 +57,7 @@ pub struct Setup {
     pub tilt: f64,
     /// Allowed tilt range (radians) for gouge avoidance.
     pub range: (f64, f64),
-    /// Length of the tool body above the tip that the gouge check probes (mm).
+    /// Length of the tool body above the tip that the gouge check takes (mm).
     pub length: f64,
     /// Penetration tolerated before a pose counts as gouging (mm).
     pub gouge_tol: f64,
@@ -137,18 +137,15 @@ pub fn fixed_axis_ball_tip(centre: &P3, axis: &V3, r: f64) -> P3 {
     centre - axis * r
 }
 
-/// The attitude of one row; with a model, the tool body is checked and the tilt adjusted inside
+/// The attitude of one row; with a part, the tool body is checked and the tilt adjusted inside
 /// the range where the tool has a free tilt (cylinder, ball).
-pub fn attitude(setup: &Setup, c: &Contact, model: Option<&Model>) -> Result<Attitude, RowError> {
+pub fn attitude(setup: &Setup, c: &Contact, part: Option<&Part>) -> Result<Attitude, RowError> {
     let n = c.normal;
-    let gouge_at =
-        |pose: &Pose, probes: &dyn Fn(&Pose) -> Vec<gouge::Probe>| model.map(|m| gouge::penetration(m, &probes(pose)));
     match setup.shape {
         Shape::Cylinder { radius, cut_depth } => {
             let f = pose::tangent_feed(&n, &c.feed).ok_or(RowError::FeedAlongNormal)?;
             let make = |t: f64| pose::cylinder(&c.point, &n, &f, radius, t);
-            let probes = |p: &Pose| gouge::cylinder_probes(&p.tip, &p.axis, p.edge.as_ref(), radius, setup.length);
-            let (tilt, gouge, adjusted) = tilt_search(setup, model, &|t| make(t), &probes);
+            let (tilt, gouge, adjusted) = tilt_search(setup, part, &make);
             Ok(Attitude {
                 pose: make(tilt),
                 tilt,
@@ -163,24 +160,23 @@ pub fn attitude(setup: &Setup, c: &Contact, model: Option<&Model>) -> Result<Att
             let f = pose::tangent_feed(&n, &c.feed).ok_or(RowError::FeedAlongNormal)?;
             let dir = if side { f.cross(&n) } else { f };
             let make = |t: f64| pose::ball(&c.point, &n, &dir, radius, t);
-            let probes = |p: &Pose| gouge::ball_probes(&p.tip, &p.axis, radius, setup.length);
-            let (tilt, gouge, adjusted) = tilt_search(setup, model, &|t| make(t), &probes);
+            let (tilt, gouge, adjusted) = tilt_search(setup, part, &make);
             Ok(Attitude { pose: make(tilt), tilt, edge_radius: None, machine: None, flank_gap: None, gouge, adjusted })
         }
-        Shape::FlatMill { radius } => {
+        Shape::FlatMill { .. } => {
             let pose = pose::flat_mill(&c.point, &n);
-            let gouge = gouge_at(&pose, &|p| gouge::cylinder_probes(&p.tip, &p.axis, None, radius, setup.length));
             Ok(Attitude {
                 pose,
                 tilt: 0.0,
                 edge_radius: None,
                 machine: Some(pose::machine_angles(&pose.axis)),
                 flank_gap: None,
-                gouge,
+                gouge: part.map(|p| p.penetration(&pose)),
                 adjusted: false,
             })
         }
         Shape::FlatType { edge, control_second } => {
+            let model = part.map(|p| &p.model);
             let (p2, n2) = c.second.ok_or(RowError::NoSecondContact)?;
             let (control, other, index) =
                 if control_second { ((p2, n2), n, c.surfaces.1) } else { ((c.point, n), n2, c.surfaces.0) };
@@ -205,15 +201,10 @@ pub fn attitude(setup: &Setup, c: &Contact, model: Option<&Model>) -> Result<Att
     }
 }
 
-/// The requested tilt, or with a model the clear tilt nearest it inside the range.
-fn tilt_search(
-    setup: &Setup,
-    model: Option<&Model>,
-    make: &dyn Fn(f64) -> Pose,
-    probes: &dyn Fn(&Pose) -> Vec<gouge::Probe>,
-) -> (f64, Option<f64>, bool) {
-    let Some(m) = model else { return (setup.tilt, None, false) };
-    let g = |t: f64| gouge::penetration(m, &probes(&make(t)));
-    let a = gouge::adjust(setup.tilt, setup.range.0, setup.range.1, setup.gouge_tol, g);
+/// The requested tilt, or with a part the clear tilt nearest it inside the range (the whole body
+/// clear, see [`gouge::adjust`]).
+fn tilt_search(setup: &Setup, part: Option<&Part>, make: &dyn Fn(f64) -> Pose) -> (f64, Option<f64>, bool) {
+    let Some(p) = part else { return (setup.tilt, None, false) };
+    let a = gouge::adjust(setup.tilt, setup.range.0, setup.range.1, setup.gouge_tol, |t| p.penetration(&make(t)));
     (a.tilt, Some(a.gouge), a.tilt != setup.tilt)
 }

@@ -15,6 +15,7 @@ use rayon::prelude::*;
 use std::process::ExitCode;
 use std::time::Instant;
 use tool_attitude::flat_type::Edge;
+use tool_attitude::gouge::Part;
 use tool_attitude::{Attitude, Contact, RowError, Setup, Shape, attitude, edge, pose};
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -307,22 +308,17 @@ fn run_fixed(args: &Args, tool: &Tool, tool_file: &str, axis: V3, started: Insta
     if t.rows.is_empty() {
         return Err(Error::input("no rows").at(Location::file(&input.name)));
     }
-    let model = match &args.model {
-        Some(m) => Some(Model::load(&Input::open(m)?)?),
-        None => None,
-    };
     let r = tool.radius;
     let length = tool.length.unwrap_or(4.0 * r);
+    let part = load_part(args, tool, length, true)?;
     t.schema.add(&[Col::I, Col::J, Col::K]);
-    let c_gouge = model.is_some().then(|| t.add_extra_column("gouge"));
+    let c_gouge = part.is_some().then(|| t.add_extra_column("gouge"));
     let gouges: Vec<f64> = t
         .rows
         .par_iter()
         .map(|row| {
             let tip = tool_attitude::fixed_axis_ball_tip(&row.pos, &axis, r);
-            model.as_ref().map_or(0.0, |m| {
-                tool_attitude::gouge::penetration(m, &tool_attitude::gouge::ball_probes(&tip, &axis, r, length))
-            })
+            part.as_ref().map_or(0.0, |p| p.penetration(&tool_attitude::pose::Pose { tip, axis, edge: None }))
         })
         .collect();
     let num = |v: f64| {
@@ -351,6 +347,7 @@ fn run_fixed(args: &Args, tool: &Tool, tool_file: &str, axis: V3, started: Insta
         .set("gouge_rows", gouging.len())
         .set("gouge_tol_mm", args.gouge_tol)
         .set("largest_gouge_mm", largest)
+        .set("gouge_chord_mm", part.as_ref().map(Part::chord_error))
         .set("seconds", started.elapsed().as_secs_f64());
     if let Some(path) = &args.io.report {
         report.write(path)?;
@@ -374,10 +371,9 @@ fn run(args: Args) -> Result<()> {
         return run_fixed(&args, &tool, &tool_input.name, axis, started);
     }
     let setup = setup(&args, &tool, &tool_input.name)?;
-    let model = match &args.model {
-        Some(m) => Some(Model::load(&Input::open(m)?)?),
-        None => None,
-    };
+    let solid = !matches!(setup.shape, Shape::FlatType { .. });
+    let part = load_part(&args, &tool, setup.length, solid)?;
+    let model = part.as_ref().map(|p| &p.model);
     let input = Input::open(&args.io.input)?;
     let mut t = table::read(&input, &[Col::X, Col::Y, Col::Z, Col::Px, Col::Py, Col::Pz, Col::Nx, Col::Ny, Col::Nz])?;
     if t.rows.is_empty() {
@@ -385,13 +381,13 @@ fn run(args: Args) -> Result<()> {
             .at(Location::file(&input.name)));
     }
     let needs_second = matches!(setup.shape, Shape::FlatType { .. });
-    let cs = contacts(&t, &input.name, model.as_ref(), needs_second)?;
+    let cs = contacts(&t, &input.name, model, needs_second)?;
     if needs_second && model.is_some() && cs.iter().any(|c| c.surfaces.0.is_none() || c.surfaces.1.is_none()) {
         cli::warn("rows without `surface`/`surface2` names of the model: their flat-type axis uses the tangent planes");
     }
     let solved_at = Instant::now();
     let results: Vec<std::result::Result<Attitude, RowError>> =
-        cs.par_iter().map(|c| attitude(&setup, c, model.as_ref())).collect();
+        cs.par_iter().map(|c| attitude(&setup, c, part.as_ref())).collect();
     let seconds_solve = solved_at.elapsed().as_secs_f64();
     let mut poses = Vec::with_capacity(results.len());
     for (k, r) in results.into_iter().enumerate() {
@@ -423,7 +419,7 @@ fn run(args: Args) -> Result<()> {
     let c_ac =
         matches!(setup.shape, Shape::FlatMill { .. }).then(|| (t.add_extra_column("ac_a"), t.add_extra_column("ac_c")));
     let c_gap = needs_second.then(|| t.add_extra_column("flank_gap"));
-    let c_gouge = model.is_some().then(|| t.add_extra_column("gouge"));
+    let c_gouge = part.is_some().then(|| t.add_extra_column("gouge"));
     let num = |v: f64| {
         let mut b = Vec::new();
         camkit::num::push_shortest(&mut b, v);
@@ -464,6 +460,8 @@ fn run(args: Args) -> Result<()> {
         .set("gouge_lines", gouging.iter().take(20).map(|&k| t.rows[k].line).collect::<Vec<_>>())
         .set("gouge_tol_mm", setup.gouge_tol)
         .set("largest_gouge_mm", poses.iter().filter_map(|a| a.gouge).fold(0.0, f64::max))
+        .set("gouge_check", part.as_ref().map(|_| if solid { "body" } else { "flank-probes" }))
+        .set("gouge_chord_mm", part.as_ref().map(Part::chord_error))
         .set("largest_axis_unit_error", checks.unit)
         .set("largest_tilt_error_rad", checks.tilt)
         .set("largest_tip_distance_error_mm", checks.tip)
@@ -487,6 +485,16 @@ fn run(args: Args) -> Result<()> {
     }
     let largest = poses.iter().filter_map(|a| a.gouge).fold(0.0, f64::max);
     deliver(&args, &t, &input.name, &gouging, setup.gouge_tol, largest)
+}
+
+/// The part of `--model` (none without): the model, and with `solid` the tool body of `length`
+/// and the model as a solid, its tessellated surfaces within a quarter of --gouge-tol (at least
+/// 1e-6 mm, at most 2 µm).
+fn load_part(args: &Args, tool: &Tool, length: f64, solid: bool) -> Result<Option<Part>> {
+    let Some(file) = &args.model else { return Ok(None) };
+    let model = Model::load(&Input::open(file)?)?;
+    let chord = (0.25 * args.gouge_tol).clamp(1e-6, 0.002);
+    Part::new(model, tool, length, chord, solid).map(Some).map_err(|e| Error::input(e).at(Location::file(file)))
 }
 
 /// Writes the table, after rows that gouge (indices `gouging`, the deepest `largest` mm) fail the

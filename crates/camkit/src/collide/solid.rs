@@ -7,11 +7,17 @@
 //! behind each surface's outward normal, from a camkit [`Model`]: meshes as triangle meshes
 //! (closed ones also answer "is this point inside"), spheres and planes as exact balls and
 //! half-spaces, B-spline patches as triangle meshes within a stated chord error.
+//! [`Solid::of_any`] also takes every other analytic surface, for clearance queries: unbounded
+//! cylinders exactly (a rod as a cylinder long enough for the query, a bore in closed form: see
+//! [`super::closed_form`]), flipped spheres in closed form, bounded cylinders as exact cylinders
+//! (flipped ones, cones and tori as triangle meshes within the chord).
 
+use super::closed_form::{Extreme, Hollow};
 use crate::doc::tool::{Tool, ToolKind};
 use crate::geom::{P3, V3};
 use crate::model::analytic::Analytic;
 use crate::model::{Aabb, Geometry, Model};
+use parry3d_f64::bounding_volume::BoundingVolume;
 use parry3d_f64::math::{Pose, Vector};
 use parry3d_f64::query::{self, ShapeCastOptions};
 use parry3d_f64::shape::{SharedShape, TriMeshFlags};
@@ -68,6 +74,16 @@ impl Piece {
             PieceKind::Wedge => unreachable!("wedges are built with their corners"),
         };
         Piece { pose, shape, kind, holder: false }
+    }
+
+    /// The slab along the tool axis that holds the piece and the largest distance of its points
+    /// from the axis: (lowest height, highest height, radius); `None` for a wedge.
+    fn span(&self) -> Option<(f64, f64, f64)> {
+        match self.kind {
+            PieceKind::Capsule { from, to, radius } => Some((from - radius, to.max(from) + radius, radius)),
+            PieceKind::Cylinder { from, to, radius, .. } => Some((from, to, radius)),
+            PieceKind::Wedge => None,
+        }
     }
 
     /// The piece shrunk by `e` (every surface moved `e` inwards); `None` if nothing is left.
@@ -151,6 +167,51 @@ impl Body {
     pub fn sweeps_exactly(&self) -> bool {
         self.pieces.iter().all(|p| p.holder || matches!(p.kind, PieceKind::Capsule { .. }))
     }
+
+    /// The body's extreme parts at `at`, in model coordinates (see [`super::closed_form`]): a
+    /// capsule's end centres padded by its radius, a cylinder's rim circles (of a rounded one the
+    /// circles its rounding's centres run on, padded by the corner radius), a wedge's corners.
+    fn extremes(&self, at: &Placement) -> Vec<Extreme> {
+        let (x, y, z) = at.frame();
+        let world = |p: Vector| at.tip + x * p.x + y * p.y + z * p.z;
+        let mut out = Vec::with_capacity(2 * self.pieces.len() + 1);
+        for p in &self.pieces {
+            match p.kind {
+                PieceKind::Capsule { from, to, radius } => {
+                    for h in [from, to.max(from)] {
+                        out.push(Extreme::Point { at: at.tip + z * h, pad: radius });
+                    }
+                }
+                PieceKind::Cylinder { from, to, radius, corner } => {
+                    let mid = 0.5 * (from + to);
+                    let (lo, hi) = ((from + corner).min(mid), (to - corner).max(mid));
+                    for h in [lo, hi] {
+                        let (centre, radius) = (at.tip + z * h, (radius - corner).max(0.0));
+                        out.push(Extreme::Circle { centre, normal: z, radius, pad: corner });
+                    }
+                }
+                PieceKind::Wedge => {
+                    if let Some(t) = p.shape.as_triangle() {
+                        for c in [t.a, t.b, t.c] {
+                            out.push(Extreme::Point { at: world(p.pose * c), pad: 0.0 });
+                        }
+                    }
+                }
+            }
+        }
+        out
+    }
+
+    /// Largest distance of a point of the body from its tip (mm).
+    fn extent(&self) -> f64 {
+        self.pieces
+            .iter()
+            .map(|p| {
+                let b = p.shape.compute_aabb(&p.pose);
+                b.mins.abs().max(b.maxs.abs()).length()
+            })
+            .fold(0.0, f64::max)
+    }
 }
 
 /// Where a body is: tip, unit axis, and the edge direction for a tool whose orientation about its
@@ -166,13 +227,18 @@ pub struct Placement {
 }
 
 impl Placement {
-    fn pose(&self) -> Pose {
+    /// The tool's frame in model coordinates: edge (+X), +Y, axis (+Z).
+    fn frame(&self) -> (V3, V3, V3) {
         let z = self.axis;
         let x = self
             .edge
             .map(|e| (e - z * e.dot(&z)).normalize())
             .unwrap_or_else(|| crate::model::analytic::any_perpendicular(&z));
-        let y = z.cross(&x);
+        (x, z.cross(&x), z)
+    }
+
+    fn pose(&self) -> Pose {
+        let (x, y, z) = self.frame();
         let m = parry3d_f64::glamx::DMat3::from_cols(v(&x), v(&y), v(&z));
         Pose::from_parts(pt(&self.tip), Quat::from_mat3(&m).normalize())
     }
@@ -186,9 +252,21 @@ struct PartPiece {
     closed_mesh: bool,
 }
 
+/// An unbounded circular cylinder with the material inside: a rod.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Rod {
+    point: P3,
+    axis: V3,
+    radius: f64,
+}
+
 /// A part: the material behind each surface of a model.
 pub struct Solid {
     pieces: Vec<PartPiece>,
+    /// Material outside a sphere or a bore ([`Solid::of_any`]).
+    hollows: Vec<Hollow>,
+    /// Unbounded rods ([`Solid::of_any`]).
+    rods: Vec<Rod>,
     chord: f64,
 }
 
@@ -218,21 +296,34 @@ fn welded(corners: impl Iterator<Item = [P3; 3]>) -> (Vec<Vector>, Vec<[u32; 3]>
     (vertices, indices)
 }
 
-/// Triangles of a B-spline patch over its domain: a uniform grid refined until the patch at every
-/// cell's centre and edge midpoints lies within `chord` of the cell's two triangles (their
-/// planes), normals agreeing with the patch's outward normal (`flip` reverses it). Returns the
-/// triangles and the largest deviation seen.
-fn patch_triangles(p: &crate::model::patch::BSpline, flip: bool, chord: f64) -> (Vec<[P3; 3]>, f64) {
-    let [u0, u1, v0, v1] = p.domain();
+/// A parry cylinder (standing along its Y axis) turned onto unit `axis` about `centre`.
+fn along(centre: &P3, axis: &V3) -> Pose {
+    Pose::from_parts(pt(centre), Quat::from_rotation_arc(Vector::Y, v(axis)))
+}
+
+/// Triangles of a parametric surface `at(u, v)` over `[u0, u1, v0, v1]`: a uniform grid refined
+/// until the surface at every cell's centre and edge midpoints lies within `chord` of the cell's
+/// two triangles (their planes), the triangles turned to agree with the outward normal `normal`
+/// (`flip` reverses it). Returns the triangles and the largest deviation seen.
+fn surface_triangles(
+    [u0, u1, v0, v1]: [f64; 4],
+    at: &dyn Fn(f64, f64) -> P3,
+    normal: &dyn Fn(f64, f64) -> Option<V3>,
+    flip: bool,
+    chord: f64,
+) -> (Vec<[P3; 3]>, f64) {
     let mut n = 8usize;
     loop {
-        let at =
-            |i: usize, j: usize| p.eval(u0 + (u1 - u0) * i as f64 / n as f64, v0 + (v1 - v0) * j as f64 / n as f64).s;
+        let uv = |i: f64, j: f64| (u0 + (u1 - u0) * i / n as f64, v0 + (v1 - v0) * j / n as f64);
+        let grid = |i: usize, j: usize| {
+            let (u, v) = uv(i as f64, j as f64);
+            at(u, v)
+        };
         let mut tris = Vec::with_capacity(2 * n * n);
         let mut worst = 0.0f64;
         for i in 0..n {
             for j in 0..n {
-                let (a, b, c, d) = (at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1));
+                let (a, b, c, d) = (grid(i, j), grid(i + 1, j), grid(i + 1, j + 1), grid(i, j + 1));
                 for (t, probes) in [
                     ([a, b, c], [(0.75, 0.25), (0.5, 0.0), (1.0, 0.5)]),
                     ([a, c, d], [(0.25, 0.75), (0.5, 1.0), (0.0, 0.5)]),
@@ -240,19 +331,13 @@ fn patch_triangles(p: &crate::model::patch::BSpline, flip: bool, chord: f64) -> 
                     let nrm = (t[1] - t[0]).cross(&(t[2] - t[0]));
                     let len = nrm.norm();
                     for (du, dv) in probes {
-                        let q = p
-                            .eval(
-                                u0 + (u1 - u0) * (i as f64 + du) / n as f64,
-                                v0 + (v1 - v0) * (j as f64 + dv) / n as f64,
-                            )
-                            .s;
+                        let (u, v) = uv(i as f64 + du, j as f64 + dv);
                         if len > 0.0 {
-                            worst = worst.max(((q - t[0]).dot(&nrm) / len).abs());
+                            worst = worst.max(((at(u, v) - t[0]).dot(&nrm) / len).abs());
                         }
                     }
-                    let mid =
-                        (u0 + (u1 - u0) * (i as f64 + 0.5) / n as f64, v0 + (v1 - v0) * (j as f64 + 0.5) / n as f64);
-                    let out = p.normal(mid.0, mid.1).map(|m| if flip { -m } else { m });
+                    let (mu, mv) = uv(i as f64 + 0.5, j as f64 + 0.5);
+                    let out = normal(mu, mv).map(|m| if flip { -m } else { m });
                     let t = if out.is_some_and(|m| m.dot(&nrm) < 0.0) { [t[0], t[2], t[1]] } else { t };
                     tris.push(t);
                 }
@@ -265,54 +350,192 @@ fn patch_triangles(p: &crate::model::patch::BSpline, flip: bool, chord: f64) -> 
     }
 }
 
+/// A piece of material for a mesh of triangles: a closed, consistently oriented one answers
+/// "inside" when `solid_inside`; any other is a sheet.
+fn mesh_piece(name: &str, corners: impl Iterator<Item = [P3; 3]>, solid_inside: bool) -> Result<PartPiece, String> {
+    let (vertices, indices) = welded(corners);
+    if solid_inside
+        && let Ok(shape) = SharedShape::trimesh_with_flags(vertices.clone(), indices.clone(), TriMeshFlags::ORIENTED)
+    {
+        return Ok(PartPiece { pose: Pose::identity(), shape, closed_mesh: true });
+    }
+    let shape = SharedShape::trimesh(vertices, indices).map_err(|e| format!("surface {name}: {e:?}"))?;
+    Ok(PartPiece { pose: Pose::identity(), shape, closed_mesh: false })
+}
+
+/// Signed clearance (at most `reach`) between a body piece round the tool axis (at `pos`; within
+/// heights `lo..hi` of the axis from the tip of `at` and `radius` of it) and a triangle mesh: the
+/// same as parry's contact of the piece with the whole mesh, but triangles that the piece's slab
+/// or its cylinder round the axis separates from it by more than `reach` (exact, cheap tests) are
+/// not handed to GJK/EPA — under a tool standing on a surface most of them are.
+fn mesh_clearance(
+    part: &PartPiece,
+    mesh: &parry3d_f64::shape::TriMesh,
+    piece: &Piece,
+    pos: &Pose,
+    at: &Placement,
+    (lo, hi, radius): (f64, f64, f64),
+    reach: f64,
+) -> f64 {
+    let (tip, axis) = (pt(&at.tip), v(&at.axis));
+    let reach_out = reach.max(0.0);
+    // Distance from the axis line of a point (the line, not the segment: a lower bound).
+    let off_axis = |p: Vector| {
+        let d = p - tip;
+        (d - axis * d.dot(axis)).length()
+    };
+    let mut best = reach;
+    // The piece's box in the mesh's frame, grown by the reach.
+    let query = piece.shape.compute_aabb(&(part.pose.inverse() * pos)).loosened(reach_out);
+    // Whole subtrees go the same way: a node's box outside the slab, or farther from the axis
+    // than the radius, holds no triangle that could touch.
+    let (axis_abs, local_tip, local_axis) = {
+        let inv = part.pose.inverse();
+        let a = inv.rotation * axis;
+        (a.abs(), inv * tip, a)
+    };
+    let keep = |node: &parry3d_f64::partitioning::BvhNode| {
+        let b = node.aabb();
+        if !b.intersects(&query) {
+            return false;
+        }
+        let (c, e) = (b.center(), b.half_extents());
+        let (h, spread) = ((c - local_tip).dot(local_axis), e.dot(axis_abs));
+        if h + spread < lo - reach_out || h - spread > hi + reach_out {
+            return false;
+        }
+        let d = c - local_tip;
+        (d - local_axis * d.dot(local_axis)).length() - e.length() <= radius + reach_out
+    };
+    for i in mesh.bvh().leaves(keep) {
+        let t = mesh.triangle(i);
+        let corners = [part.pose * t.a, part.pose * t.b, part.pose * t.c];
+        let h = corners.map(|c| (c - tip).dot(axis));
+        if h.iter().all(|&x| x < lo - reach_out) || h.iter().all(|&x| x > hi + reach_out) {
+            continue;
+        }
+        let centre = (corners[0] + corners[1] + corners[2]) / 3.0;
+        let spread = corners.iter().map(|c| (*c - centre).length()).fold(0.0, f64::max);
+        if off_axis(centre) - spread > radius + reach_out {
+            continue;
+        }
+        let tri = parry3d_f64::shape::Triangle::new(corners[0], corners[1], corners[2]);
+        if let Ok(Some(c)) = query::contact(&Pose::identity(), &tri, pos, piece.shape.as_ref(), reach) {
+            best = best.min(c.dist);
+        }
+    }
+    best
+}
+
 impl Solid {
     /// The part of a model: meshes and patches as triangle meshes (patches within `chord` mm),
     /// spheres as balls and planes as half-spaces (their outward normals flipped as the model
     /// says). Other analytic surfaces (cylinders, cones, tori) and flipped spheres are refused
     /// with what they are: give such a part as an STL.
     pub fn of(model: &Model, chord: f64) -> Result<Solid, String> {
-        let mut pieces = Vec::new();
-        let mut worst = 0.0f64;
+        Solid::build(model, chord, false)
+    }
+
+    /// The part of a model for [`Solid::clearance`], every surface taken: as [`Solid::of`], and
+    /// also unbounded cylinders (inside: a rod, exact; flipped: a bore, in closed form), flipped
+    /// spheres (a cavity, in closed form), bounded cylinders (inside: an exact cylinder with flat
+    /// ends; flipped: triangles within `chord`), cones and tori (triangles within `chord`; a
+    /// torus's mesh is closed and answers "inside"). [`Solid::first_within`] is not for such a
+    /// solid: it counts every move as hitting at once when the solid has a rod or hollow.
+    pub fn of_any(model: &Model, chord: f64) -> Result<Solid, String> {
+        Solid::build(model, chord, true)
+    }
+
+    fn build(model: &Model, chord: f64, any: bool) -> Result<Solid, String> {
+        let mut solid = Solid { pieces: Vec::new(), hollows: Vec::new(), rods: Vec::new(), chord: 0.0 };
         for s in &model.surfaces {
             let place = |p: P3| s.placement.map_or(p, |iso| iso * p);
             let turn = |n: V3| s.placement.map_or(n, |iso| iso * n);
+            // A surface given by its parametrisation in its own frame, as triangles placed.
+            let tessellated = |at: &dyn Fn(f64, f64) -> P3,
+                               normal: &dyn Fn(f64, f64) -> Option<V3>,
+                               domain: [f64; 4],
+                               closed: bool|
+             -> Result<(PartPiece, f64), String> {
+                let (tris, dev) = surface_triangles(domain, at, normal, s.flip, chord);
+                Ok((mesh_piece(&s.name, tris.into_iter().map(|t| t.map(place)), closed && !s.flip)?, dev))
+            };
+            let mut add = |(piece, dev): (PartPiece, f64)| {
+                solid.chord = solid.chord.max(dev);
+                solid.pieces.push(piece);
+            };
+            let tau = std::f64::consts::TAU;
             match &s.geometry {
-                Geometry::Mesh(m) => {
-                    let (vertices, indices) = welded(m.corners().map(|t| t.map(place)));
-                    let (shape, closed) = match SharedShape::trimesh_with_flags(
-                        vertices.clone(),
-                        indices.clone(),
-                        TriMeshFlags::ORIENTED,
-                    ) {
-                        Ok(shape) => (shape, true),
-                        Err(_) => (
-                            SharedShape::trimesh(vertices, indices)
-                                .map_err(|e| format!("surface {}: {e:?}", s.name))?,
-                            false,
-                        ),
-                    };
-                    pieces.push(PartPiece { pose: Pose::identity(), shape, closed_mesh: closed });
-                }
+                Geometry::Mesh(m) => add((mesh_piece(&s.name, m.corners().map(|t| t.map(place)), true)?, 0.0)),
                 Geometry::Patch(p) => {
-                    let (tris, dev) = patch_triangles(p, s.flip, chord);
-                    worst = worst.max(dev);
-                    let (vertices, indices) = welded(tris.into_iter().map(|t| t.map(place)));
-                    let shape =
-                        SharedShape::trimesh(vertices, indices).map_err(|e| format!("surface {}: {e:?}", s.name))?;
-                    pieces.push(PartPiece { pose: Pose::identity(), shape, closed_mesh: false });
+                    add(tessellated(&|u, v| p.eval(u, v).s, &|u, v| p.normal(u, v), p.domain(), false)?)
                 }
-                Geometry::Analytic(Analytic::Sphere { centre, radius }) if !s.flip => pieces.push(PartPiece {
-                    pose: Pose::from_translation(pt(&place(*centre))),
-                    shape: SharedShape::ball(*radius),
-                    closed_mesh: false,
-                }),
+                Geometry::Analytic(Analytic::Sphere { centre, radius }) if !s.flip => add((
+                    PartPiece {
+                        pose: Pose::from_translation(pt(&place(*centre))),
+                        shape: SharedShape::ball(*radius),
+                        closed_mesh: false,
+                    },
+                    0.0,
+                )),
                 Geometry::Analytic(Analytic::Plane { point, normal }) => {
                     let n = turn(if s.flip { -*normal } else { *normal });
-                    pieces.push(PartPiece {
-                        pose: Pose::from_translation(pt(&place(*point))),
-                        shape: SharedShape::halfspace(v(&n.normalize())),
-                        closed_mesh: false,
-                    });
+                    add((
+                        PartPiece {
+                            pose: Pose::from_translation(pt(&place(*point))),
+                            shape: SharedShape::halfspace(v(&n.normalize())),
+                            closed_mesh: false,
+                        },
+                        0.0,
+                    ));
+                }
+                Geometry::Analytic(Analytic::Sphere { centre, radius }) if any => {
+                    solid.hollows.push(Hollow::Cavity { centre: place(*centre), radius: *radius })
+                }
+                Geometry::Analytic(Analytic::Cylinder { point, axis, radius, from, to }) if any => {
+                    let (at, along_axis, radius) = (place(*point), turn(*axis), *radius);
+                    let e = crate::model::analytic::any_perpendicular(axis);
+                    let radial = |u: f64| e * u.cos() + axis.cross(&e) * u.sin();
+                    match (from.is_finite() && to.is_finite(), s.flip) {
+                        (false, false) => solid.rods.push(Rod { point: at, axis: along_axis, radius }),
+                        (false, true) => solid.hollows.push(Hollow::Bore { point: at, axis: along_axis, radius }),
+                        (true, false) => add((
+                            PartPiece {
+                                pose: along(&(at + along_axis * (0.5 * (from + to))), &along_axis),
+                                shape: SharedShape::cylinder(0.5 * (to - from), radius),
+                                closed_mesh: false,
+                            },
+                            0.0,
+                        )),
+                        (true, true) => add(tessellated(
+                            &|u, h| point + axis * h + radial(u) * radius,
+                            &|u, _| Some(radial(u)),
+                            [0.0, tau, *from, *to],
+                            false,
+                        )?),
+                    }
+                }
+                Geometry::Analytic(Analytic::Cone { apex, axis, half_angle, from, to }) if any => {
+                    let e = crate::model::analytic::any_perpendicular(axis);
+                    let radial = |u: f64| e * u.cos() + axis.cross(&e) * u.sin();
+                    let (sn, cs, tn) = (half_angle.sin(), half_angle.cos(), half_angle.tan());
+                    add(tessellated(
+                        &|u, h| apex + axis * h + radial(u) * (h * tn),
+                        &|u, _| Some(radial(u) * cs - axis * sn),
+                        [0.0, tau, *from, *to],
+                        false,
+                    )?)
+                }
+                Geometry::Analytic(Analytic::Torus { centre, axis, major, minor }) if any => {
+                    let e = crate::model::analytic::any_perpendicular(axis);
+                    let radial = |u: f64| e * u.cos() + axis.cross(&e) * u.sin();
+                    let tube = |u: f64, w: f64| radial(u) * w.cos() + axis * w.sin();
+                    add(tessellated(
+                        &|u, w| centre + radial(u) * *major + tube(u, w) * *minor,
+                        &|u, w| Some(tube(u, w)),
+                        [0.0, tau, 0.0, tau],
+                        true,
+                    )?)
                 }
                 Geometry::Analytic(a) => {
                     let what = match a {
@@ -329,7 +552,7 @@ impl Solid {
                 }
             }
         }
-        Ok(Solid { pieces, chord: worst })
+        Ok(solid)
     }
 
     /// Largest distance between a tessellated patch and its triangles (mm; 0 without patches).
@@ -346,6 +569,10 @@ impl Solid {
         for part in &self.pieces {
             for piece in &body.pieces {
                 let pos = pose * piece.pose;
+                if let (Some(mesh), Some((lo, hi, radius))) = (part.shape.as_trimesh(), piece.span()) {
+                    best = best.min(mesh_clearance(part, mesh, piece, &pos, at, (lo, hi, radius), reach));
+                    continue;
+                }
                 // The part first: parry 0.31 gives a wrong sign for a shape against a half-space
                 // given second (right with it first).
                 if let Ok(Some(c)) = query::contact(&part.pose, part.shape.as_ref(), &pos, piece.shape.as_ref(), reach)
@@ -360,6 +587,29 @@ impl Solid {
                 }
             }
         }
+        if !self.rods.is_empty() {
+            // A finite stretch of each rod, centred level with the tip and reaching past the body
+            // by more than `reach`: the same as the unbounded rod within the query's reach.
+            let half = body.extent() + reach.max(0.0) + 1.0;
+            for rod in &self.rods {
+                let centre = rod.point + rod.axis * (at.tip - rod.point).dot(&rod.axis);
+                let shape = parry3d_f64::shape::Cylinder::new(half, rod.radius);
+                for piece in &body.pieces {
+                    let pos = pose * piece.pose;
+                    if let Ok(Some(c)) =
+                        query::contact(&along(&centre, &rod.axis), &shape, &pos, piece.shape.as_ref(), reach)
+                    {
+                        best = best.min(c.dist);
+                    }
+                }
+            }
+        }
+        if !self.hollows.is_empty() {
+            let extremes = body.extremes(at);
+            for h in &self.hollows {
+                best = best.min(h.clearance(&extremes));
+            }
+        }
         best
     }
 
@@ -370,6 +620,9 @@ impl Solid {
     /// bull-nose, wedge) are not cast: see [`Body::sweeps_exactly`]. A capsule thinner than the
     /// allowed penetration counts as hitting at once.
     pub fn first_within(&self, body: &Body, at: &Placement, to_tip: &P3, limit: f64) -> Option<f64> {
+        if !(self.rods.is_empty() && self.hollows.is_empty()) {
+            return Some(0.0);
+        }
         let mut cast: Vec<(Piece, f64)> = Vec::new();
         for p in &body.pieces {
             match (p.holder, p.kind) {
@@ -526,6 +779,57 @@ mod tests {
         assert!((c - 0.5).abs() < 1e-9, "{c}");
     }
 
+    /// Every analytic surface in [`Solid::of_any`]: a rod and a bore (unbounded cylinders), a
+    /// cavity (a flipped sphere) and a bounded rod against closed forms; a torus's closed mesh
+    /// answers "inside" and stays within its chord.
+    #[test]
+    fn of_any_takes_every_analytic_surface() {
+        let flat = Body::of(&tool(r#"{"kind": "flat", "radius": 12.5, "length": 40}"#));
+        let cyl = |point: P3, axis: V3, radius: f64, length: Option<(f64, f64)>, flip: bool| {
+            let (from, to) = length.unwrap_or((f64::NEG_INFINITY, f64::INFINITY));
+            Solid::of_any(&model(Geometry::Analytic(Analytic::Cylinder { point, axis, radius, from, to }), flip), 1e-3)
+                .unwrap()
+        };
+        // A 1 mm rod along x, 0.2 mm into the side of the upright tool at heights 10 and 39.
+        for z in [10.0, 39.0] {
+            let rod = cyl(P3::new(0.0, 12.2, z), V3::x(), 0.5, None, false);
+            let c = rod.clearance(&flat, &at(P3::new(500.0, 0.0, 0.0), V3::z()), 1.0);
+            assert!((c + 0.8).abs() < 1e-6, "{c}");
+        }
+        // Bounded: the same rod from x = 0 to 40 misses a tool standing at x = 60.
+        let rod = cyl(P3::new(0.0, 12.2, 10.0), V3::x(), 0.5, Some((0.0, 40.0)), false);
+        assert!(rod.clearance(&flat, &at(P3::new(60.0, 0.0, 0.0), V3::z()), 1.0) >= 1.0);
+        assert!((rod.clearance(&flat, &at(P3::new(20.0, 0.0, 0.0), V3::z()), 1.0) + 0.8).abs() < 1e-6);
+        // A bore of radius 100 along y through (0, 0, 100): the rim farthest from its axis.
+        let bore = cyl(P3::new(0.0, 0.0, 100.0), V3::y(), 100.0, None, true);
+        for h in [0.5, 0.1, 3.0] {
+            let want = 100.0 - 12.5f64.hypot(100.0 - h);
+            let c = bore.clearance(&flat, &at(P3::new(0.0, 7.0, h), V3::z()), 1.0);
+            assert!((c - want.min(1.0)).abs() < 1e-9, "{c} vs {want}");
+        }
+        // Solid::of refuses what its swept cast cannot take.
+        let flipped = model(Geometry::Analytic(Analytic::Sphere { centre: P3::origin(), radius: 50.0 }), true);
+        assert!(Solid::of(&flipped, 1e-3).is_err());
+        // A cavity of radius 50: a ball end mill's lowest point 0.5 above its bottom.
+        let cavity = Solid::of_any(
+            &model(Geometry::Analytic(Analytic::Sphere { centre: P3::origin(), radius: 50.0 }), true),
+            1e-3,
+        )
+        .unwrap();
+        let ball = Body::of(&tool(r#"{"kind": "ball", "radius": 3, "length": 20}"#));
+        let c = cavity.clearance(&ball, &at(P3::new(0.0, 0.0, -49.5), V3::z()), 1.0);
+        assert!((c - 0.5).abs() < 1e-12, "{c}");
+        // A torus: within its chord, and a tip inside its tube is found however small the tool.
+        let torus = Analytic::Torus { centre: P3::origin(), axis: V3::z(), major: 20.0, minor: 5.0 };
+        let solid = Solid::of_any(&model(Geometry::Analytic(torus), false), 1e-3).unwrap();
+        assert!(solid.chord_error() <= 1e-3);
+        let small = Body::of(&tool(r#"{"kind": "ball", "radius": 0.5, "length": 1}"#));
+        assert!(solid.clearance(&small, &at(P3::new(20.0, 0.0, -1.0), V3::z()), 1.0) < -3.0);
+        let c = solid.clearance(&small, &at(P3::new(0.0, 0.0, 0.0), V3::z()), 20.0);
+        // The ball's centre is 0.5 up the axis: sqrt(20² + 0.5²) − 5 from the torus.
+        assert!((c - (20f64.hypot(0.5) - 5.5)).abs() < 1e-3 + 1e-9, "{c}");
+    }
+
     proptest! {
         #![proptest_config(ProptestConfig { cases: 48, ..ProptestConfig::default() })]
 
@@ -585,14 +889,8 @@ mod tests {
         let m = model(Geometry::Patch(patch), false);
         let solid = Solid::of(&m, 0.01).unwrap();
         assert!(solid.chord_error() <= 0.01 && solid.chord_error() > 0.0, "{}", solid.chord_error());
-        let (tris, _) = patch_triangles(
-            match &m.surfaces[0].geometry {
-                Geometry::Patch(p) => p,
-                _ => unreachable!(),
-            },
-            false,
-            0.01,
-        );
+        let Geometry::Patch(p) = &m.surfaces[0].geometry else { unreachable!() };
+        let (tris, _) = surface_triangles(p.domain(), &|u, v| p.eval(u, v).s, &|u, v| p.normal(u, v), false, 0.01);
         for t in tris.iter().step_by(7) {
             let centre = P3::from((t[0].coords + t[1].coords + t[2].coords) / 3.0);
             assert!(m.nearest(&centre).distance <= 0.01 + 1e-9);
