@@ -468,7 +468,9 @@ fn bad_input_gets_one_clear_line_and_no_output() {
     };
     stl("empty.stl").fails(2, "empty.stl: empty STL file");
     stl("cut.stl").fails(2, "cut.stl: truncated binary STL");
-    stl("flat.stl").fails(2, "flat.stl (facet 2): degenerate triangle");
+    w.run(BIN, &["flat.stl", "-r", "1", "--strict", "-o", "out.csv"], b"")
+        .fails(2, "flat.stl (facet 2): degenerate triangle (zero area): corners (0, 0, 0), (1, 0, 0), (2, 0, 0)");
+    assert!(!w.exists("out.csv"));
     run(r#"{"surfaces": [{"type": "stl", "file": "missing.stl"}]}"#, &["-r", "1"]).fails(2, "(surfaces[0].file)");
 }
 
@@ -913,4 +915,76 @@ fn box_mesh(lo: P3, hi: P3) -> Vec<[P3; 3]> {
     let c = |i: usize| P3::new([lo.x, hi.x][i & 1], [lo.y, hi.y][(i >> 1) & 1], [lo.z, hi.z][(i >> 2) & 1]);
     let quads = [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]];
     quads.iter().flat_map(|q| [[c(q[0]), c(q[1]), c(q[2])], [c(q[0]), c(q[2]), c(q[3])]]).collect()
+}
+
+// Issue 19: STL files as users have them.
+
+/// An OpenSCAD-style STL: a closed box with zero-area slivers along its edges (collinear
+/// corners, as a CSG union leaves them) and a facet written twice. Today the first sliver
+/// refuses the whole file; now the slivers and the repeat are left out with one warning and
+/// counted in the report, the box is traced exactly as without them, and --strict refuses,
+/// naming the facet.
+#[test]
+fn openscad_slivers_and_a_duplicate_facet_are_dropped_and_counted() {
+    let w = Work::new();
+    let clean = box_mesh(P3::new(0.0, 0.0, 0.0), P3::new(30.0, 20.0, 10.0));
+    let mut scad = clean.clone();
+    for k in 0..22 {
+        // A sliver on the top edge y = 0: three collinear points.
+        let x = 1.0 + k as f64;
+        scad.insert(
+            2 * k % scad.len(),
+            [P3::new(x, 0.0, 10.0), P3::new(x + 0.5, 0.0, 10.0), P3::new(x + 0.25, 0.0, 10.0)],
+        );
+    }
+    scad.push(clean[3]);
+    w.write("box.stl", camkit::model::mesh::binary_stl(&clean));
+    w.write("scad.stl", camkit::model::mesh::binary_stl(&scad));
+    let args = ["-r", "3", "--pick", "2"];
+    let out = w.run(BIN, &[&["box.stl", "-o", "box.csv", "--report", "box.json"], &args[..]].concat(), b"");
+    out.ok();
+    assert!(out.stderr.is_empty(), "{}", out.stderr);
+    let out = w.run(BIN, &[&["scad.stl", "-o", "scad.csv", "--report", "scad.json"], &args[..]].concat(), b"");
+    out.ok();
+    let first = scad.iter().position(|t| *t == clean[3]).unwrap() + 1;
+    assert_eq!(
+        out.stderr.trim_end(),
+        format!(
+            "stylus-trace: warning: scad.stl: 22 zero-area facets (the first facet 1) and 1 duplicate facets (the first facet 35, a repeat of facet {first}) dropped (--strict refuses them)"
+        )
+    );
+    let (clean_rep, scad_rep) = (report(&w, "box.json"), report(&w, "scad.json"));
+    assert_eq!(
+        (scad_rep["degenerate_facets_dropped"].as_u64(), scad_rep["duplicate_facets_dropped"].as_u64()),
+        (Some(22), Some(1))
+    );
+    assert_eq!(clean_rep["degenerate_facets_dropped"], 0);
+    assert_eq!((scad_rep["triangles"].as_u64(), scad_rep["points"].clone()), (Some(12), clean_rep["points"].clone()));
+    assert_eq!(w.read("scad.csv").replace("scad", "box"), w.read("box.csv"));
+    w.run(BIN, &[&["scad.stl", "--strict", "-o", "strict.csv"], &args[..]].concat(), b"").fails(
+        2,
+        "scad.stl (facet 1): degenerate triangle (zero area): corners (13, 0, 10), (13.5, 0, 10), (13.25, 0, 10)",
+    );
+    assert!(!w.exists("strict.csv"));
+}
+
+/// An open mesh (a box with its top face taken out: a hole) is traced like any mesh: nearest
+/// points need no closed solid. Over the hole the stylus goes down inside the box; every CL
+/// point is r from the triangles by brute force.
+#[test]
+fn a_mesh_with_a_hole_is_traced() {
+    let w = Work::new();
+    let mut tris = box_mesh(P3::new(0.0, 0.0, 0.0), P3::new(30.0, 20.0, 10.0));
+    tris.drain(2..4);
+    w.write("open.stl", camkit::model::mesh::binary_stl(&tris));
+    let (cl, rep, stderr) = scan(&w, "open.stl", &["-r", "3", "--pick", "2"]);
+    assert!(stderr.is_empty(), "{stderr}");
+    assert_eq!(rep["triangles"], 10);
+    let tris = as_f32(&tris);
+    for q in &cl {
+        let d = mesh_distance(&q.c, &tris);
+        assert!((d - 3.0).abs() <= CONTACT, "{:?} is {d} from the mesh", q.c);
+    }
+    // Inside the box, down at its floor: the stylus centre 3 mm above z = 0.
+    assert!(cl.iter().any(|q| (q.c.z - 3.0).abs() <= CONTACT && q.c.x > 5.0 && q.c.x < 25.0));
 }

@@ -98,6 +98,9 @@ struct Args {
     /// Worker threads (default: all cores, at most 256); the output is the same for any number.
     #[arg(long, value_name = "N")]
     threads: Option<usize>,
+    /// Refuse an STL file with zero-area or repeated facets (default: they are left out, with a warning).
+    #[arg(long)]
+    strict: bool,
     /// Largest memory (MB: CL points, their rows, the scan lines), estimated before the run; more is refused.
     #[arg(long, default_value_t = budget::DEFAULT_MEMORY_MB, value_name = "MB")]
     max_memory: u64,
@@ -306,6 +309,7 @@ fn run(args: Args) -> Result<()> {
     let started = Instant::now();
     let input = Input::open(&args.io.input)?;
     let model = Model::load(&input)?;
+    model.check_dropped(args.strict)?;
     let loaded = started.elapsed().as_secs_f64();
     let opts = options(&args, &model, &input)?;
     let progress = Progress::new(opts.mode.units() as u64, opts.mode.tag());
@@ -362,6 +366,8 @@ fn run(args: Args) -> Result<()> {
             .set("chord_tol_mm", opts.steps.chord_tol)
             .set("surfaces", model.surfaces.len())
             .set("triangles", model.triangles())
+            .set("degenerate_facets_dropped", model.dropped_counts().0)
+            .set("duplicate_facets_dropped", model.dropped_counts().1)
             .set("units", opts.mode.units())
             .set("paths", paths.len())
             .set("interrupted_passes", interrupted)

@@ -81,6 +81,9 @@ struct Args {
     /// The model (JSON document or STL) for gouge checks and the flat-type correction.
     #[arg(long, value_name = "FILE")]
     model: Option<String>,
+    /// Refuse a model's STL file with zero-area or repeated facets (default: left out, with a warning).
+    #[arg(long)]
+    strict: bool,
     /// Penetration (mm) of the tool body into the model tolerated before a pose gouges.
     #[arg(long, default_value_t = 0.001, value_name = "MM")]
     gouge_tol: f64,
@@ -90,6 +93,14 @@ struct Args {
     /// Decimals of written positions (default: shortest exact text).
     #[arg(long, value_name = "N")]
     decimals: Option<u32>,
+}
+
+/// The `--model`, its STL files' dropped facets warned about (or refused with `--strict`).
+fn load_model(args: &Args) -> Result<Option<Model>> {
+    let Some(file) = &args.model else { return Ok(None) };
+    let model = Model::load(&Input::open(file)?)?;
+    model.check_dropped(args.strict)?;
+    Ok(Some(model))
 }
 
 fn after_help() -> String {
@@ -307,10 +318,7 @@ fn run_fixed(args: &Args, tool: &Tool, tool_file: &str, axis: V3, started: Insta
     if t.rows.is_empty() {
         return Err(Error::input("no rows").at(Location::file(&input.name)));
     }
-    let model = match &args.model {
-        Some(m) => Some(Model::load(&Input::open(m)?)?),
-        None => None,
-    };
+    let model = load_model(args)?;
     let r = tool.radius;
     let length = tool.length.unwrap_or(4.0 * r);
     t.schema.add(&[Col::I, Col::J, Col::K]);
@@ -343,6 +351,10 @@ fn run_fixed(args: &Args, tool: &Tool, tool_file: &str, axis: V3, started: Insta
     }
     let largest = gouges.iter().copied().fold(0.0, f64::max);
     let mut report = Report::new("tool-attitude");
+    if let Some(m) = &model {
+        let (degenerate, duplicate) = m.dropped_counts();
+        report.set("degenerate_facets_dropped", degenerate).set("duplicate_facets_dropped", duplicate);
+    }
     report
         .set("tool", tool)
         .set("fixed_axis", [axis.x, axis.y, axis.z])
@@ -374,10 +386,7 @@ fn run(args: Args) -> Result<()> {
         return run_fixed(&args, &tool, &tool_input.name, axis, started);
     }
     let setup = setup(&args, &tool, &tool_input.name)?;
-    let model = match &args.model {
-        Some(m) => Some(Model::load(&Input::open(m)?)?),
-        None => None,
-    };
+    let model = load_model(&args)?;
     let input = Input::open(&args.io.input)?;
     let mut t = table::read(&input, &[Col::X, Col::Y, Col::Z, Col::Px, Col::Py, Col::Pz, Col::Nx, Col::Ny, Col::Nz])?;
     if t.rows.is_empty() {
@@ -453,6 +462,10 @@ fn run(args: Args) -> Result<()> {
         }
     }
     let mut report = Report::new("tool-attitude");
+    if let Some(m) = &model {
+        let (degenerate, duplicate) = m.dropped_counts();
+        report.set("degenerate_facets_dropped", degenerate).set("duplicate_facets_dropped", duplicate);
+    }
     report
         .set("tool", &tool)
         .set("rows", t.rows.len())
