@@ -190,6 +190,8 @@ struct PartPiece {
 pub struct Solid {
     pieces: Vec<PartPiece>,
     chord: f64,
+    /// Names of the mesh surfaces that are not closed and consistently oriented.
+    open: Vec<String>,
 }
 
 /// Grid (mm) vertices are welded on: corners given back as `a + (b − a)` differ from `b` by
@@ -216,6 +218,19 @@ fn welded(corners: impl Iterator<Item = [P3; 3]>) -> (Vec<Vector>, Vec<[u32; 3]>
         }
     }
     (vertices, indices)
+}
+
+/// True when the welded triangles close a surface: every edge is met once in each direction by
+/// two triangles (no hole, no edge shared by three, orientations agreeing). parry's `ORIENTED`
+/// flag alone accepts an open mesh, whose "inside" is then wrong near the hole.
+fn closed(indices: &[[u32; 3]]) -> bool {
+    let mut edges = std::collections::HashMap::with_capacity(3 * indices.len());
+    for t in indices {
+        for k in 0..3 {
+            *edges.entry((t[k], t[(k + 1) % 3])).or_insert(0u32) += 1;
+        }
+    }
+    edges.iter().all(|(&(a, b), &n)| n == 1 && edges.get(&(b, a)) == Some(&1))
 }
 
 /// Triangles of a B-spline patch over its domain: a uniform grid refined until the patch at every
@@ -272,6 +287,7 @@ impl Solid {
     /// with what they are: give such a part as an STL.
     pub fn of(model: &Model, chord: f64) -> Result<Solid, String> {
         let mut pieces = Vec::new();
+        let mut open = Vec::new();
         let mut worst = 0.0f64;
         for s in &model.surfaces {
             let place = |p: P3| s.placement.map_or(p, |iso| iso * p);
@@ -279,18 +295,22 @@ impl Solid {
             match &s.geometry {
                 Geometry::Mesh(m) => {
                     let (vertices, indices) = welded(m.corners().map(|t| t.map(place)));
+                    let is_closed = closed(&indices);
                     let (shape, closed) = match SharedShape::trimesh_with_flags(
                         vertices.clone(),
                         indices.clone(),
                         TriMeshFlags::ORIENTED,
                     ) {
-                        Ok(shape) => (shape, true),
+                        Ok(shape) => (shape, is_closed),
                         Err(_) => (
                             SharedShape::trimesh(vertices, indices)
                                 .map_err(|e| format!("surface {}: {e:?}", s.name))?,
                             false,
                         ),
                     };
+                    if !closed {
+                        open.push(s.name.clone());
+                    }
                     pieces.push(PartPiece { pose: Pose::identity(), shape, closed_mesh: closed });
                 }
                 Geometry::Patch(p) => {
@@ -329,7 +349,15 @@ impl Solid {
                 }
             }
         }
-        Ok(Solid { pieces, chord: worst })
+        Ok(Solid { pieces, chord: worst, open })
+    }
+
+    /// Mesh surfaces that are open or not consistently oriented (a hole, a non-manifold edge):
+    /// clearances to their triangles are measured as for any mesh, but whether a point lies
+    /// inside needs a closed mesh, so a tool wholly inside such a part is not seen. Filters say
+    /// so rather than leave it silent.
+    pub fn open_meshes(&self) -> &[String] {
+        &self.open
     }
 
     /// Largest distance between a tessellated patch and its triangles (mm; 0 without patches).
@@ -502,6 +530,16 @@ mod tests {
         let tip = P3::new(0.0, 0.0, -50.0) + n * 50.0 - V3::z() * 0.0;
         let c = sphere.clearance(&ball, &at(tip + n * 3.1 - V3::z() * 3.0, V3::z()), 10.0);
         assert!((c - 0.1).abs() < 1e-9, "ball centre 53.1 from the sphere's centre: {c}");
+    }
+
+    /// A closed sphere mesh answers "inside"; with a facet taken out (a hole) it is named open.
+    #[test]
+    fn a_mesh_with_a_hole_is_named_open() {
+        let tris = mesh_sphere(P3::origin(), 20.0, 24);
+        let closed = Solid::of(&model(Geometry::Mesh(Mesh::new(&tris).unwrap()), false), 0.002).unwrap();
+        assert!(closed.open_meshes().is_empty());
+        let holed = Solid::of(&model(Geometry::Mesh(Mesh::new(&tris[1..]).unwrap()), false), 0.002).unwrap();
+        assert_eq!(holed.open_meshes(), ["s"]);
     }
 
     #[test]
