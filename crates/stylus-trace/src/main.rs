@@ -213,7 +213,7 @@ fn options(args: &Args, model: &Model, input: &Input) -> Result<Options> {
             }
             let pick = positive(args.pick, "--pick")?;
             let lines = budget::scan_lines(&region, args.angle, pick);
-            budget::scan(lines, &region, &area, args.angle, pick, &stylus, &steps).check(
+            budget::scan(lines, &region, &area, heights[1] - heights[0], args.angle, pick, &stylus, &steps).check(
                 &bounds,
                 &format!(
                     "scan mode at --pick {pick} ({lines:.3e} lines) over {within} (--region, --chord-tol, --max-step)"
