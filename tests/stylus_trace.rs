@@ -468,7 +468,9 @@ fn bad_input_gets_one_clear_line_and_no_output() {
     };
     stl("empty.stl").fails(2, "empty.stl: empty STL file");
     stl("cut.stl").fails(2, "cut.stl: truncated binary STL");
-    stl("flat.stl").fails(2, "flat.stl (facet 2): degenerate triangle");
+    w.run(BIN, &["flat.stl", "-r", "1", "--strict", "-o", "out.csv"], b"")
+        .fails(2, "flat.stl (facet 2): degenerate triangle (zero area): corners (0, 0, 0), (1, 0, 0), (2, 0, 0)");
+    assert!(!w.exists("out.csv"));
     run(r#"{"surfaces": [{"type": "stl", "file": "missing.stl"}]}"#, &["-r", "1"]).fails(2, "(surfaces[0].file)");
 }
 
@@ -733,4 +735,256 @@ fn coverage_is_measured_on_the_rounded_output() {
     assert!(gap > 0.0 && gap <= 0.002, "{r}");
     let (gap_measured, below) = coverage_along_x(&cl, 20.0, 80.0, &floating_ball_envelope);
     assert!(gap_measured <= 0.002 && below <= 2e-3, "{gap_measured} {below}");
+}
+
+// Issue 20 P4: every filter estimates its work and memory before it starts and refuses what
+// would exceed its bounds; absurd option values are refused naming the option.
+
+/// Runs stylus-trace in `w` under a 4 GiB address-space limit and a 20 s timeout (`timeout`
+/// exits 124 when it strikes, a signal shows as 128 + its number).
+fn bounded_run(w: &Work, args: &[&str]) -> e2e::Outcome {
+    let bin = e2e::bin(BIN);
+    let script = "ulimit -v 4194304; exec \"$0\" \"$@\"";
+    let mut all = vec!["20", "sh", "-c", script, bin.to_str().unwrap()];
+    all.extend_from_slice(args);
+    let out = std::process::Command::new("timeout")
+        .args(&all)
+        .current_dir(w.path(""))
+        .env_remove("RUST_BACKTRACE")
+        .stdin(std::process::Stdio::null())
+        .output()
+        .expect("spawn");
+    e2e::Outcome {
+        status: out.status.code().unwrap_or(-1),
+        stdout: out.stdout,
+        stderr: String::from_utf8_lossy(&out.stderr).into_owned(),
+    }
+}
+
+/// The reproducers of issue 20 P4, built here: once 4 GiB allocation failures or hours, now
+/// one line naming the option or the model, exit 2, at once.
+#[test]
+fn p4_runs_past_their_bounds_are_refused_before_they_start() {
+    let w = Work::new();
+    w.write(
+        "sphere.json",
+        r#"{"surfaces": [{"type": "sphere", "name": "R500", "centre": [0, 0, -500], "radius": 500}]}"#,
+    );
+    // A closed box mesh with one corner pulled 4.29e9 mm out (a stray vertex), and the box ×1e12.
+    let mut stray = box_mesh(P3::new(-20.0, -20.0, 0.0), P3::new(20.0, 20.0, 20.0));
+    stray[4][2].y = 4.294967296e9;
+    w.write("stray.stl", camkit::model::mesh::binary_stl(&stray));
+    let huge: Vec<[P3; 3]> =
+        box_mesh(P3::new(-20.0, -20.0, 0.0), P3::new(20.0, 20.0, 20.0)).iter().map(|t| t.map(|p| p * 1e12)).collect();
+    w.write("huge.stl", camkit::model::mesh::binary_stl(&huge));
+    let cases: [(&[&str], &str); 6] = [
+        (&["stray.stl", "-r", "5", "--pick", "5"], "stray.stl: the area traced within the model's bounding box"),
+        (&["huge.stl", "-r", "5", "--pick", "5"], "beyond 3.518e9 mm where the round-off"),
+        (&["sphere.json", "-r", "12.5", "--pick", "1e-9", "--region", "-20,20,-20,20"], "(--max-memory)"),
+        (&["sphere.json", "-r", "12.5", "--mode", "contour", "--z-step", "1e-9"], "contour mode at --z-step"),
+        (&["sphere.json", "-r", "12.5", "--pick", "10", "--region", "-1e300,1e300,-1,1"], "--region reaches 1e300"),
+        (&["sphere.json", "-r", "12.5", "--pick", "0.5", "--max-points", "1000"], "(--max-points)"),
+    ];
+    for (args, needle) in cases {
+        let started = std::time::Instant::now();
+        let out = bounded_run(&w, args);
+        out.fails(2, needle);
+        assert!(started.elapsed().as_secs_f64() < 5.0, "{args:?} took {:?}", started.elapsed());
+    }
+    // Within the bounds the same model is traced.
+    let out =
+        bounded_run(&w, &["sphere.json", "-r", "12.5", "--pick", "10", "--region", "-1e3,1e3,-1,1", "-o", "s.csv"]);
+    assert_eq!(out.status, 0, "{}", out.stderr);
+    assert!(rows(&w.read("s.csv")).len() > 100);
+}
+
+/// Seeded property test over every numeric option (alone and three at a time): 0, negative,
+/// NaN, infinities, 1e-300, 1e300 and ordinary values never panic, exit 0, 1 or 2 only, with
+/// one stderr line when they fail, within 20 s and 4 GiB.
+#[test]
+fn every_numeric_option_is_bounded_for_any_value() {
+    let w = Work::new();
+    w.write("ball.json", r#"{"surfaces": [{"type": "sphere", "name": "ball", "centre": [0,0,10], "radius": 10}]}"#);
+    w.write(
+        "two.json",
+        r#"{"surfaces": [{"type": "plane", "name": "floor", "point": [0,0,0], "normal": [0,0,1]},
+                         {"type": "sphere", "name": "ball", "centre": [0,0,10], "radius": 10}]}"#,
+    );
+    w.write("box.stl", camkit::model::mesh::binary_stl(&box_mesh(P3::new(0.0, 0.0, 0.0), P3::new(10.0, 8.0, 5.0))));
+    let values = [
+        "0",
+        "-1",
+        "NaN",
+        "inf",
+        "-inf",
+        "1e-300",
+        "1e300",
+        "-1e300",
+        "1e-9",
+        "1e9",
+        "0.5",
+        "3",
+        "-0",
+        "1e-5",
+        "1e5",
+        "4294967297",
+        "18446744073709551616",
+    ];
+    // Option, its base mode's arguments, and how a value is placed (X: the value in a list).
+    let options: [(&str, &[&str], &str); 19] = [
+        ("-r", &["ball.json", "--pick", "2"], "X"),
+        ("--pick", &["ball.json", "-r", "2"], "X"),
+        ("--angle", &["ball.json", "-r", "2", "--pick", "2"], "X"),
+        ("--chord-tol", &["box.stl", "-r", "2", "--pick", "2"], "X"),
+        ("--contact-tol", &["ball.json", "-r", "2", "--pick", "2"], "X"),
+        ("--max-step", &["box.stl", "-r", "2", "--pick", "2"], "X"),
+        ("--min-step", &["ball.json", "-r", "2", "--pick", "2"], "X"),
+        ("--decimals", &["ball.json", "-r", "2", "--pick", "2"], "X"),
+        ("--threads", &["ball.json", "-r", "2", "--pick", "2"], "X"),
+        ("--max-memory", &["ball.json", "-r", "2", "--pick", "2"], "X"),
+        ("--max-points", &["ball.json", "-r", "2", "--pick", "2"], "X"),
+        ("--region", &["ball.json", "-r", "2", "--pick", "2"], "X,5,-5,5"),
+        ("--region", &["box.stl", "-r", "2", "--pick", "2"], "-5,X,-5,5"),
+        ("--region", &["ball.json", "-r", "2", "--pick", "2"], "-5,5,-5,X"),
+        ("--z-step", &["ball.json", "-r", "2", "--mode", "contour"], "X"),
+        ("--levels", &["box.stl", "-r", "2", "--mode", "contour"], "3,X"),
+        ("--region", &["box.stl", "-r", "2", "--mode", "contour", "--levels", "3"], "-5,5,-5,X"),
+        ("--start", &["two.json", "-r", "2", "--mode", "two-surface", "--region", "-20,20,-20,20"], "X,0,2"),
+        ("--start", &["two.json", "-r", "2", "--mode", "two-surface", "--region", "-20,20,-20,20"], "6,0,X"),
+    ];
+    let check = |args: &[String]| {
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        let started = std::time::Instant::now();
+        let out = bounded_run(&w, &args);
+        let took = started.elapsed().as_secs_f64();
+        assert!(matches!(out.status, 0..=2), "{args:?}: status {}, stderr {}", out.status, out.stderr);
+        assert!(!out.stderr.contains("internal error") && !out.stderr.contains("panicked"), "{args:?}: {}", out.stderr);
+        if out.status != 0 {
+            let last = out.stderr.trim_end().lines().filter(|l| !l.contains(": warning: ")).count();
+            assert_eq!(last, 1, "{args:?}: one error line: {}", out.stderr);
+        }
+        assert!(took < 20.0, "{args:?} took {took} s");
+        out.status
+    };
+    let mut statuses = [0usize; 3];
+    let with = |(opt, base, shape): &(&str, &[&str], &str), v: &str| -> Vec<String> {
+        let mut a: Vec<String> = base.iter().map(|s| s.to_string()).collect();
+        a.extend(["-o".into(), "o.csv".into(), format!("{opt}={}", shape.replace('X', v))]);
+        // The time is bounded by --max-points: a tenth of the default keeps each run short.
+        if *opt != "--max-points" {
+            a.push("--max-points=1e7".into());
+        }
+        a
+    };
+    for o in &options {
+        for v in values {
+            statuses[check(&with(o, v)) as usize] += 1;
+        }
+    }
+    // Three options of the scan mode at once (not --max-points), seeded.
+    let mut seed = 0x9e37_79b9_7f4a_7c15u64;
+    let mut next = move |n: usize| {
+        seed ^= seed << 13;
+        seed ^= seed >> 7;
+        seed ^= seed << 17;
+        (seed >> 11) as usize % n
+    };
+    for _ in 0..40 {
+        let mut chosen: Vec<usize> = Vec::new();
+        while chosen.len() < 3 {
+            let k = next(10);
+            if !chosen.contains(&k) {
+                chosen.push(k);
+            }
+        }
+        let mut a: Vec<String> = ["box.stl", "-o", "o.csv", "--max-points=1e7"].map(String::from).to_vec();
+        for (opt, default) in [("-r", "2"), ("--pick", "2")] {
+            if !chosen.iter().any(|&k| options[k].0 == opt) {
+                a.push(format!("{opt}={default}"));
+            }
+        }
+        a.extend(chosen.iter().map(|&k| format!("{}={}", options[k].0, values[next(values.len())])));
+        statuses[check(&a) as usize] += 1;
+    }
+    eprintln!("statuses 0/1/2: {statuses:?}");
+    assert!(statuses[0] > 20 && statuses[2] > 100, "{statuses:?}");
+}
+
+/// A closed box from `lo` to `hi`: 12 triangles, corners counter-clockwise seen from outside.
+fn box_mesh(lo: P3, hi: P3) -> Vec<[P3; 3]> {
+    let c = |i: usize| P3::new([lo.x, hi.x][i & 1], [lo.y, hi.y][(i >> 1) & 1], [lo.z, hi.z][(i >> 2) & 1]);
+    let quads = [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]];
+    quads.iter().flat_map(|q| [[c(q[0]), c(q[1]), c(q[2])], [c(q[0]), c(q[2]), c(q[3])]]).collect()
+}
+
+// Issue 19: STL files as users have them.
+
+/// An OpenSCAD-style STL: a closed box with zero-area slivers along its edges (collinear
+/// corners, as a CSG union leaves them) and a facet written twice. Today the first sliver
+/// refuses the whole file; now the slivers and the repeat are left out with one warning and
+/// counted in the report, the box is traced exactly as without them, and --strict refuses,
+/// naming the facet.
+#[test]
+fn openscad_slivers_and_a_duplicate_facet_are_dropped_and_counted() {
+    let w = Work::new();
+    let clean = box_mesh(P3::new(0.0, 0.0, 0.0), P3::new(30.0, 20.0, 10.0));
+    let mut scad = clean.clone();
+    for k in 0..22 {
+        // A sliver on the top edge y = 0: three collinear points.
+        let x = 1.0 + k as f64;
+        scad.insert(
+            2 * k % scad.len(),
+            [P3::new(x, 0.0, 10.0), P3::new(x + 0.5, 0.0, 10.0), P3::new(x + 0.25, 0.0, 10.0)],
+        );
+    }
+    scad.push(clean[3]);
+    w.write("box.stl", camkit::model::mesh::binary_stl(&clean));
+    w.write("scad.stl", camkit::model::mesh::binary_stl(&scad));
+    let args = ["-r", "3", "--pick", "2"];
+    let out = w.run(BIN, &[&["box.stl", "-o", "box.csv", "--report", "box.json"], &args[..]].concat(), b"");
+    out.ok();
+    assert!(out.stderr.is_empty(), "{}", out.stderr);
+    let out = w.run(BIN, &[&["scad.stl", "-o", "scad.csv", "--report", "scad.json"], &args[..]].concat(), b"");
+    out.ok();
+    let first = scad.iter().position(|t| *t == clean[3]).unwrap() + 1;
+    assert_eq!(
+        out.stderr.trim_end(),
+        format!(
+            "stylus-trace: warning: scad.stl: 22 zero-area facets (the first facet 1) and 1 duplicate facets (the first facet 35, a repeat of facet {first}) dropped (--strict refuses them)"
+        )
+    );
+    let (clean_rep, scad_rep) = (report(&w, "box.json"), report(&w, "scad.json"));
+    assert_eq!(
+        (scad_rep["degenerate_facets_dropped"].as_u64(), scad_rep["duplicate_facets_dropped"].as_u64()),
+        (Some(22), Some(1))
+    );
+    assert_eq!(clean_rep["degenerate_facets_dropped"], 0);
+    assert_eq!((scad_rep["triangles"].as_u64(), scad_rep["points"].clone()), (Some(12), clean_rep["points"].clone()));
+    assert_eq!(w.read("scad.csv").replace("scad", "box"), w.read("box.csv"));
+    w.run(BIN, &[&["scad.stl", "--strict", "-o", "strict.csv"], &args[..]].concat(), b"").fails(
+        2,
+        "scad.stl (facet 1): degenerate triangle (zero area): corners (13, 0, 10), (13.5, 0, 10), (13.25, 0, 10)",
+    );
+    assert!(!w.exists("strict.csv"));
+}
+
+/// An open mesh (a box with its top face taken out: a hole) is traced like any mesh: nearest
+/// points need no closed solid. Over the hole the stylus goes down inside the box; every CL
+/// point is r from the triangles by brute force.
+#[test]
+fn a_mesh_with_a_hole_is_traced() {
+    let w = Work::new();
+    let mut tris = box_mesh(P3::new(0.0, 0.0, 0.0), P3::new(30.0, 20.0, 10.0));
+    tris.drain(2..4);
+    w.write("open.stl", camkit::model::mesh::binary_stl(&tris));
+    let (cl, rep, stderr) = scan(&w, "open.stl", &["-r", "3", "--pick", "2"]);
+    assert!(stderr.is_empty(), "{stderr}");
+    assert_eq!(rep["triangles"], 10);
+    let tris = as_f32(&tris);
+    for q in &cl {
+        let d = mesh_distance(&q.c, &tris);
+        assert!((d - 3.0).abs() <= CONTACT, "{:?} is {d} from the mesh", q.c);
+    }
+    // Inside the box, down at its floor: the stylus centre 3 mm above z = 0.
+    assert!(cl.iter().any(|q| (q.c.z - 3.0).abs() <= CONTACT && q.c.x > 5.0 && q.c.x < 25.0));
 }

@@ -524,3 +524,38 @@ fn a_rod_beside_the_tool_side_is_found_at_any_height() {
         }
     }
 }
+
+/// Issue 19: a model STL with a zero-area sliver and a repeated facet (a box as OpenSCAD leaves
+/// it) is gouge-checked like the clean box, with one warning and the counts in the report;
+/// `--strict` refuses it naming the facet.
+#[test]
+fn model_stl_slivers_are_dropped_with_a_warning_or_refused_strictly() {
+    let w = Work::new();
+    let (lo, hi) = ([0.0, 0.0, 0.0], [30.0, 20.0, 10.0]);
+    let c = |i: usize| P3::new([lo[0], hi[0]][i & 1], [lo[1], hi[1]][(i >> 1) & 1], [lo[2], hi[2]][(i >> 2) & 1]);
+    let quads = [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]];
+    let mut tris: Vec<[P3; 3]> =
+        quads.iter().flat_map(|q| [[c(q[0]), c(q[1]), c(q[2])], [c(q[0]), c(q[2]), c(q[3])]]).collect();
+    w.write("box.stl", camkit::model::mesh::binary_stl(&tris));
+    tris.insert(5, [c(4), P3::new(10.0, 0.0, 10.0), c(5)]);
+    tris.push(tris[2]);
+    w.write("scad.stl", camkit::model::mesh::binary_stl(&tris));
+    w.write("ball.json", r#"{"kind": "ball", "radius": 3, "length": 20}"#);
+    let cl = w.run("stylus-trace", &["box.stl", "-r", "3", "--pick", "4"], b"").ok();
+    w.write("cl.csv", &cl);
+    let args = |model: &'static str, report: &'static str| {
+        ["cl.csv", "--tool", "ball.json", "--axis", "0,0,1", "--model", model, "--report", report]
+    };
+    let clean = w.run(BIN, &args("box.stl", "box.json"), b"");
+    let scad = w.run(BIN, &args("scad.stl", "scad.json"), b"");
+    assert_eq!(scad.ok(), clean.ok());
+    assert_eq!(
+        scad.stderr.trim_end(),
+        "tool-attitude: warning: scad.stl: 1 zero-area facets (the first facet 6) and 1 duplicate facets (the first facet 14, a repeat of facet 3) dropped (--strict refuses them)"
+    );
+    let r: serde_json::Value = serde_json::from_str(&w.read("scad.json")).unwrap();
+    assert_eq!((r["degenerate_facets_dropped"].as_u64(), r["duplicate_facets_dropped"].as_u64()), (Some(1), Some(1)));
+    assert!(r["largest_gouge_mm"].as_f64().unwrap() < 1e-6, "{r}");
+    w.run(BIN, &[&args("scad.stl", "s.json")[..], &["--strict"]].concat(), b"")
+        .fails(2, "scad.stl (facet 6): degenerate triangle (zero area)");
+}

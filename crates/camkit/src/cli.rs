@@ -127,6 +127,23 @@ impl Kind {
     }
 }
 
+/// Parses the command line. A usage error (an unknown option, a value that is no number) is an
+/// input error of one line naming the option, like every other bad input, rather than clap's
+/// three lines; `--help` and `--version` print and exit as usual.
+pub fn parse_args<A: clap::Parser>() -> Result<A> {
+    A::try_parse().map_err(|e| match e.kind() {
+        clap::error::ErrorKind::DisplayHelp
+        | clap::error::ErrorKind::DisplayVersion
+        | clap::error::ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand => e.exit(),
+        _ => {
+            let text = e.render().to_string();
+            // The message runs to the first blank line (a missing option is on the next line).
+            let lines: Vec<&str> = text.lines().map(str::trim).take_while(|l| !l.is_empty()).collect();
+            Error::input(lines.join(" ").trim_start_matches("error: ").to_string())
+        }
+    })
+}
+
 /// Prints a warning on stderr (`name: warning: ...`).
 pub fn warn(message: &str) {
     eprintln!("{}: warning: {}", program(), printable(message));

@@ -316,7 +316,13 @@ fn walls_of(job: &Job) -> Option<Walls> {
 /// tessellated within a quarter of the tolerance (at most 2 µm).
 fn solid_of(job: &Job) -> Result<Option<(Solid, Body)>> {
     let Some(Part::Model(model)) = &job.part else { return Ok(None) };
+    model.check_dropped(false)?;
     let solid = Solid::of(model, (0.25 * job.tolerance).min(0.002)).map_err(|e| job.error("part.model", e))?;
+    for name in solid.open_meshes() {
+        cli::warn(&format!(
+            "part.model: surface {name} is an open or non-manifold mesh: the tool's clearance to its triangles is checked, but a tool wholly inside it is not seen (that needs a closed mesh)"
+        ));
+    }
     Ok(Some((solid, Body::of(&job.tool))))
 }
 
@@ -401,6 +407,10 @@ fn collide(
         .set("part_blocks_sampled", so.sampled)
         .set("part_samples", so.samples)
         .set("model_chord_error_mm", solid.map(|(s, _)| s.chord_error()));
+    if let Some(Part::Model(m)) = &job.part {
+        let (degenerate, duplicate) = m.dropped_counts();
+        report.set("degenerate_facets_dropped", degenerate).set("duplicate_facets_dropped", duplicate);
+    }
     if let Some((nc_line, what)) = &o.first {
         let message = format!(
             "collision check: NC line {nc_line}: {what} ({} rapids into material, {} moves too near the part)",

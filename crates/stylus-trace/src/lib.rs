@@ -10,6 +10,7 @@
 //! and the plot; [`verify`] re-measures every CL point against the whole model, and in scan mode
 //! [`coverage`] compares every line with an independent drop of the stylus ([`envelope`]).
 
+pub mod budget;
 pub mod contour;
 pub mod coverage;
 pub mod curve;

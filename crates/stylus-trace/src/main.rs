@@ -11,6 +11,7 @@ use camkit::table::{self, Col, WriteOptions};
 use clap::{Parser, ValueEnum};
 use std::path::PathBuf;
 use std::time::Instant;
+use stylus_trace::budget::{self, Budget};
 use stylus_trace::coverage::{self, Coverage, Tolerances};
 use stylus_trace::curve::{Steps, Stylus};
 use stylus_trace::scan::Scan;
@@ -94,9 +95,18 @@ struct Args {
     /// Write an SVG (top view) of the traced lines.
     #[arg(long, value_name = "FILE")]
     svg: Option<PathBuf>,
-    /// Worker threads (default: all cores); the output is the same for any number.
+    /// Worker threads (default: all cores, at most 256); the output is the same for any number.
     #[arg(long, value_name = "N")]
     threads: Option<usize>,
+    /// Refuse an STL file with zero-area or repeated facets (default: they are left out, with a warning).
+    #[arg(long)]
+    strict: bool,
+    /// Largest memory (MB: CL points, their rows, the scan lines), estimated before the run; more is refused.
+    #[arg(long, default_value_t = budget::DEFAULT_MEMORY_MB, value_name = "MB")]
+    max_memory: u64,
+    /// Largest work in CL points and stylus drops (a few µs each), estimated before the run; more is refused.
+    #[arg(long, default_value_t = budget::DEFAULT_POINTS, value_name = "N")]
+    max_points: f64,
 }
 
 fn after_help() -> String {
@@ -119,7 +129,7 @@ fn after_help() -> String {
 }
 
 fn main() -> std::process::ExitCode {
-    cli::run("stylus-trace", || run(Args::parse()))
+    cli::run("stylus-trace", || run(cli::parse_args::<Args>()?))
 }
 
 fn usage(message: impl Into<String>) -> Error {
@@ -139,12 +149,13 @@ fn numbers(text: &str, what: &str, n: Option<usize>) -> Result<Vec<f64>> {
     Ok(v)
 }
 
-fn region(args: &Args, model: &Model) -> Result<Region> {
+fn region(args: &Args, model: &Model, contact_tol: f64) -> Result<Region> {
     if let Some(text) = &args.region {
         let v = numbers(text, "--region", Some(4))?;
         if !(v[0] < v[1] && v[2] < v[3]) {
             return Err(usage("--region must be X0,X1,Y0,Y1 with X0 < X1 and Y0 < Y1"));
         }
+        budget::check_round_off(&v, contact_tol, "--region")?;
         return Ok(Region { x0: v[0], x1: v[1], y0: v[2], y1: v[3] });
     }
     let b = model.bounds();
@@ -154,9 +165,13 @@ fn region(args: &Args, model: &Model) -> Result<Region> {
     Ok(Region { x0: b.min.x, x1: b.max.x, y0: b.min.y, y1: b.max.y })
 }
 
+/// Most worker threads: more only cost memory (a stack each).
+const MAX_THREADS: usize = 256;
+
 fn options(args: &Args, model: &Model, input: &Input) -> Result<Options> {
     let radius = positive(args.radius, "--radius")?;
     let stylus = Stylus { radius, contact_tol: positive(args.contact_tol, "--contact-tol")? };
+    budget::check_round_off(&[radius], stylus.contact_tol, "--radius")?;
     let steps = Steps {
         chord_tol: positive(args.chord_tol, "--chord-tol")?,
         max_step: positive(args.max_step, "--max-step")?,
@@ -165,7 +180,11 @@ fn options(args: &Args, model: &Model, input: &Input) -> Result<Options> {
     if steps.min_step >= steps.max_step {
         return Err(usage("--min-step must be below --max-step"));
     }
-    let region = region(args, model)?;
+    let bounds = Budget {
+        memory: args.max_memory.saturating_mul(1_000_000) as f64,
+        points: positive(args.max_points, "--max-points")?,
+    };
+    let region = region(args, model, stylus.contact_tol)?;
     let b = model.bounds();
     let misses = || {
         Error::input(format!(
@@ -174,32 +193,53 @@ fn options(args: &Args, model: &Model, input: &Input) -> Result<Options> {
         ))
         .at(Location::file(&input.name))
     };
-    if b.is_bounded()
-        && !(region.x0 <= b.max.x + radius
-            && region.x1 >= b.min.x - radius
-            && region.y0 <= b.max.y + radius
-            && region.y1 >= b.min.y - radius)
-    {
+    let Some(area) = budget::traced_area(&region, &b, radius) else {
         return Err(misses());
-    }
+    };
+    // The stylus centre's heights: over the model's top down to its bottom.
+    let heights = if b.is_bounded() { [b.min.z - radius, b.max.z + radius + 1.0] } else { [0.0, 0.0] };
+    let source = if args.region.is_some() { "--region" } else { "the model's bounding box (the default --region)" };
+    budget::check_round_off(
+        &[area.x0, area.x1, area.y0, area.y1, heights[0], heights[1]],
+        stylus.contact_tol,
+        &format!("{}: the area traced within {source}", input.name),
+    )?;
+    budget::check_min_step(steps.min_step, &[area.x0, area.x1, area.y0, area.y1, heights[0], heights[1]])?;
+    let within = format!("x {}..{}, y {}..{}", area.x0, area.x1, area.y0, area.y1);
     let mode = match args.mode {
-        ModeArg::Scan => Mode::Scan(Scan {
-            region,
-            angle: if args.angle.is_finite() { args.angle } else { return Err(usage("--angle must be a number")) },
-            pick: positive(args.pick, "--pick")?,
-            zigzag: args.zigzag,
-        }),
+        ModeArg::Scan => {
+            if !(args.angle.is_finite() && args.angle.abs() <= 360.0) {
+                return Err(usage(format!("--angle must be a number of degrees from -360 to 360, got {}", args.angle)));
+            }
+            let pick = positive(args.pick, "--pick")?;
+            let lines = budget::scan_lines(&region, args.angle, pick);
+            budget::scan(lines, &region, &area, heights[1] - heights[0], args.angle, pick, &stylus, &steps).check(
+                &bounds,
+                &format!(
+                    "scan mode at --pick {pick} ({lines:.3e} lines) over {within} (--region, --chord-tol, --max-step)"
+                ),
+            )?;
+            Mode::Scan(Scan { region, angle: args.angle, pick, zigzag: args.zigzag })
+        }
         ModeArg::Contour => {
             let levels = match (&args.levels, args.z_step) {
-                (Some(text), None) => numbers(text, "--levels", None)?,
+                (Some(text), None) => {
+                    let levels = numbers(text, "--levels", None)?;
+                    budget::check_round_off(&levels, stylus.contact_tol, "--levels")?;
+                    levels
+                }
                 (None, Some(dz)) => {
                     let dz = positive(dz, "--z-step")?;
                     if !b.is_bounded() {
                         return Err(usage("--z-step needs a bounded model: give --levels"));
                     }
+                    // Counted before any is made: a tiny step would make billions.
+                    let count = ((b.max.z - b.min.z) / dz).floor() + 1.0;
+                    budget::contour(count, &region, &area, &stylus, &steps)
+                        .check(&bounds, &format!("contour mode at --z-step {dz} ({count:.3e} levels) over {within}"))?;
                     // From just below the top of the centre's range down to the model's bottom.
                     let top = b.max.z + radius;
-                    let n = ((b.max.z - b.min.z) / dz).floor() as usize;
+                    let n = count as usize - 1;
                     (1..=n + 1).map(|k| top - k as f64 * dz).filter(|z| *z >= b.min.z).collect()
                 }
                 (Some(_), Some(_)) => return Err(usage("give either --levels or --z-step, not both")),
@@ -208,6 +248,10 @@ fn options(args: &Args, model: &Model, input: &Input) -> Result<Options> {
             if levels.is_empty() {
                 return Err(usage("no contour level lies within the model's height"));
             }
+            budget::contour(levels.len() as f64, &region, &area, &stylus, &steps).check(
+                &bounds,
+                &format!("contour mode at {} levels over {within} (--levels, --chord-tol, --max-step)", levels.len()),
+            )?;
             Mode::Contour { region, levels }
         }
         ModeArg::TwoSurface => {
@@ -236,10 +280,13 @@ fn options(args: &Args, model: &Model, input: &Input) -> Result<Options> {
             let start = match &args.start {
                 Some(text) => {
                     let v = numbers(text, "--start", Some(3))?;
+                    budget::check_round_off(&v, stylus.contact_tol, "--start")?;
                     Some(P3::new(v[0], v[1], v[2]))
                 }
                 None => None,
             };
+            budget::two_surface(&area, heights[1] - heights[0], &steps)
+                .check(&bounds, &format!("two-surface mode over {within} (--chord-tol, --max-step)"))?;
             Mode::TwoSurface(TwoSurface { surfaces, start, reverse: args.reverse, region })
         }
     };
@@ -248,8 +295,8 @@ fn options(args: &Args, model: &Model, input: &Input) -> Result<Options> {
 
 fn run(args: Args) -> Result<()> {
     if let Some(n) = args.threads {
-        if n == 0 {
-            return Err(usage("--threads must be at least 1"));
+        if n == 0 || n > MAX_THREADS {
+            return Err(usage(format!("--threads must be from 1 to {MAX_THREADS}, got {n}")));
         }
         rayon::ThreadPoolBuilder::new()
             .num_threads(n)
@@ -262,6 +309,7 @@ fn run(args: Args) -> Result<()> {
     let started = Instant::now();
     let input = Input::open(&args.io.input)?;
     let model = Model::load(&input)?;
+    model.check_dropped(args.strict)?;
     let loaded = started.elapsed().as_secs_f64();
     let opts = options(&args, &model, &input)?;
     let progress = Progress::new(opts.mode.units() as u64, opts.mode.tag());
@@ -318,6 +366,8 @@ fn run(args: Args) -> Result<()> {
             .set("chord_tol_mm", opts.steps.chord_tol)
             .set("surfaces", model.surfaces.len())
             .set("triangles", model.triangles())
+            .set("degenerate_facets_dropped", model.dropped_counts().0)
+            .set("duplicate_facets_dropped", model.dropped_counts().1)
             .set("units", opts.mode.units())
             .set("paths", paths.len())
             .set("interrupted_passes", interrupted)

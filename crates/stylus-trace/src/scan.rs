@@ -372,6 +372,10 @@ impl Tracer<'_> {
         let (mut lo, mut hi, mut best) = (0.0, bad, None);
         while hi - lo > self.steps.min_step {
             let mid = 0.5 * (lo + hi);
+            // Round-off: no length lies between them any more.
+            if mid <= lo || mid >= hi {
+                break;
+            }
             let p = self.curve.correct(&(a.cl.centre + a.tangent * mid), &a.tangent).filter(|p| {
                 (p.cl.centre - a.cl.centre).dot(&a.tangent) > 0.0 && self.on_envelope(a, p) && self.chord_clear(a, p)
             });

@@ -82,6 +82,9 @@ struct Args {
     /// The model (JSON document or STL) for gouge checks and the flat-type correction.
     #[arg(long, value_name = "FILE")]
     model: Option<String>,
+    /// Refuse a model's STL file with zero-area or repeated facets (default: left out, with a warning).
+    #[arg(long)]
+    strict: bool,
     /// Penetration (mm) of the tool body into the model tolerated before a pose gouges.
     #[arg(long, default_value_t = 0.001, value_name = "MM")]
     gouge_tol: f64,
@@ -339,6 +342,10 @@ fn run_fixed(args: &Args, tool: &Tool, tool_file: &str, axis: V3, started: Insta
     }
     let largest = gouges.iter().copied().fold(0.0, f64::max);
     let mut report = Report::new("tool-attitude");
+    if let Some(m) = part.as_ref().map(|p| &p.model) {
+        let (degenerate, duplicate) = m.dropped_counts();
+        report.set("degenerate_facets_dropped", degenerate).set("duplicate_facets_dropped", duplicate);
+    }
     report
         .set("tool", tool)
         .set("fixed_axis", [axis.x, axis.y, axis.z])
@@ -449,6 +456,10 @@ fn run(args: Args) -> Result<()> {
         }
     }
     let mut report = Report::new("tool-attitude");
+    if let Some(m) = &model {
+        let (degenerate, duplicate) = m.dropped_counts();
+        report.set("degenerate_facets_dropped", degenerate).set("duplicate_facets_dropped", duplicate);
+    }
     report
         .set("tool", &tool)
         .set("rows", t.rows.len())
@@ -493,6 +504,8 @@ fn run(args: Args) -> Result<()> {
 fn load_part(args: &Args, tool: &Tool, length: f64, solid: bool) -> Result<Option<Part>> {
     let Some(file) = &args.model else { return Ok(None) };
     let model = Model::load(&Input::open(file)?)?;
+    // Its STL files' dropped facets warned about (or refused with --strict).
+    model.check_dropped(args.strict)?;
     let chord = (0.25 * args.gouge_tol).clamp(1e-6, 0.002);
     Part::new(model, tool, length, chord, solid).map(Some).map_err(|e| Error::input(e).at(Location::file(file)))
 }

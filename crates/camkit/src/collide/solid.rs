@@ -268,6 +268,8 @@ pub struct Solid {
     /// Unbounded rods ([`Solid::of_any`]).
     rods: Vec<Rod>,
     chord: f64,
+    /// Names of the mesh surfaces that are not closed and consistently oriented.
+    open: Vec<String>,
 }
 
 /// Grid (mm) vertices are welded on: corners given back as `a + (b − a)` differ from `b` by
@@ -294,6 +296,19 @@ fn welded(corners: impl Iterator<Item = [P3; 3]>) -> (Vec<Vector>, Vec<[u32; 3]>
         }
     }
     (vertices, indices)
+}
+
+/// True when the welded triangles close a surface: every edge is met once in each direction by
+/// two triangles (no hole, no edge shared by three, orientations agreeing). parry's `ORIENTED`
+/// flag alone accepts an open mesh, whose "inside" is then wrong near the hole.
+fn closed(indices: &[[u32; 3]]) -> bool {
+    let mut edges = std::collections::HashMap::with_capacity(3 * indices.len());
+    for t in indices {
+        for k in 0..3 {
+            *edges.entry((t[k], t[(k + 1) % 3])).or_insert(0u32) += 1;
+        }
+    }
+    edges.iter().all(|(&(a, b), &n)| n == 1 && edges.get(&(b, a)) == Some(&1))
 }
 
 /// A parry cylinder (standing along its Y axis) turned onto unit `axis` about `centre`.
@@ -350,17 +365,23 @@ fn surface_triangles(
     }
 }
 
-/// A piece of material for a mesh of triangles: a closed, consistently oriented one answers
-/// "inside" when `solid_inside`; any other is a sheet.
-fn mesh_piece(name: &str, corners: impl Iterator<Item = [P3; 3]>, solid_inside: bool) -> Result<PartPiece, String> {
+/// A piece of material for a mesh of triangles, and whether the mesh is closed: a closed,
+/// consistently oriented one answers "inside" when `solid_inside`; any other is a sheet.
+fn mesh_piece(
+    name: &str,
+    corners: impl Iterator<Item = [P3; 3]>,
+    solid_inside: bool,
+) -> Result<(PartPiece, bool), String> {
     let (vertices, indices) = welded(corners);
+    let is_closed = closed(&indices);
     if solid_inside
+        && is_closed
         && let Ok(shape) = SharedShape::trimesh_with_flags(vertices.clone(), indices.clone(), TriMeshFlags::ORIENTED)
     {
-        return Ok(PartPiece { pose: Pose::identity(), shape, closed_mesh: true });
+        return Ok((PartPiece { pose: Pose::identity(), shape, closed_mesh: true }, true));
     }
     let shape = SharedShape::trimesh(vertices, indices).map_err(|e| format!("surface {name}: {e:?}"))?;
-    Ok(PartPiece { pose: Pose::identity(), shape, closed_mesh: false })
+    Ok((PartPiece { pose: Pose::identity(), shape, closed_mesh: false }, is_closed))
 }
 
 /// Signed clearance (at most `reach`) between a body piece round the tool axis (at `pos`; within
@@ -447,7 +468,8 @@ impl Solid {
     }
 
     fn build(model: &Model, chord: f64, any: bool) -> Result<Solid, String> {
-        let mut solid = Solid { pieces: Vec::new(), hollows: Vec::new(), rods: Vec::new(), chord: 0.0 };
+        let mut solid =
+            Solid { pieces: Vec::new(), hollows: Vec::new(), rods: Vec::new(), chord: 0.0, open: Vec::new() };
         for s in &model.surfaces {
             let place = |p: P3| s.placement.map_or(p, |iso| iso * p);
             let turn = |n: V3| s.placement.map_or(n, |iso| iso * n);
@@ -458,7 +480,7 @@ impl Solid {
                                closed: bool|
              -> Result<(PartPiece, f64), String> {
                 let (tris, dev) = surface_triangles(domain, at, normal, s.flip, chord);
-                Ok((mesh_piece(&s.name, tris.into_iter().map(|t| t.map(place)), closed && !s.flip)?, dev))
+                Ok((mesh_piece(&s.name, tris.into_iter().map(|t| t.map(place)), closed && !s.flip)?.0, dev))
             };
             let mut add = |(piece, dev): (PartPiece, f64)| {
                 solid.chord = solid.chord.max(dev);
@@ -466,7 +488,13 @@ impl Solid {
             };
             let tau = std::f64::consts::TAU;
             match &s.geometry {
-                Geometry::Mesh(m) => add((mesh_piece(&s.name, m.corners().map(|t| t.map(place)), true)?, 0.0)),
+                Geometry::Mesh(m) => {
+                    let (piece, closed) = mesh_piece(&s.name, m.corners().map(|t| t.map(place)), true)?;
+                    if !closed {
+                        solid.open.push(s.name.clone());
+                    }
+                    add((piece, 0.0))
+                }
                 Geometry::Patch(p) => {
                     add(tessellated(&|u, v| p.eval(u, v).s, &|u, v| p.normal(u, v), p.domain(), false)?)
                 }
@@ -553,6 +581,14 @@ impl Solid {
             }
         }
         Ok(solid)
+    }
+
+    /// Mesh surfaces that are open or not consistently oriented (a hole, a non-manifold edge):
+    /// clearances to their triangles are measured as for any mesh, but whether a point lies
+    /// inside needs a closed mesh, so a tool wholly inside such a part is not seen. Filters say
+    /// so rather than leave it silent.
+    pub fn open_meshes(&self) -> &[String] {
+        &self.open
     }
 
     /// Largest distance between a tessellated patch and its triangles (mm; 0 without patches).
@@ -755,6 +791,16 @@ mod tests {
         let tip = P3::new(0.0, 0.0, -50.0) + n * 50.0 - V3::z() * 0.0;
         let c = sphere.clearance(&ball, &at(tip + n * 3.1 - V3::z() * 3.0, V3::z()), 10.0);
         assert!((c - 0.1).abs() < 1e-9, "ball centre 53.1 from the sphere's centre: {c}");
+    }
+
+    /// A closed sphere mesh answers "inside"; with a facet taken out (a hole) it is named open.
+    #[test]
+    fn a_mesh_with_a_hole_is_named_open() {
+        let tris = mesh_sphere(P3::origin(), 20.0, 24);
+        let closed = Solid::of(&model(Geometry::Mesh(Mesh::new(&tris).unwrap()), false), 0.002).unwrap();
+        assert!(closed.open_meshes().is_empty());
+        let holed = Solid::of(&model(Geometry::Mesh(Mesh::new(&tris[1..]).unwrap()), false), 0.002).unwrap();
+        assert_eq!(holed.open_meshes(), ["s"]);
     }
 
     #[test]

@@ -1,5 +1,11 @@
 //! Triangle meshes: STL reading (binary and ASCII, through `stl_io`) with errors that name the
 //! facet, and exact nearest points through a [`Bvh`] over the triangles.
+//!
+//! STL files as users have them (OpenSCAD, scanners) hold zero-area slivers and repeated facets:
+//! neither changes a nearest point, so [`load_stl`] leaves them out and says which
+//! ([`Dropped`]); a filter warns once and reports the counts, or refuses under `--strict`
+//! ([`Dropped::refusal`]). Open and non-manifold meshes are read as they are: nearest points do
+//! not need a closed solid (what does, the inside test of `collide::solid`, says so).
 
 use super::analytic::Foot;
 use super::bvh::{Aabb, Bvh};
@@ -21,7 +27,63 @@ struct Tri {
 #[derive(Clone, Debug)]
 pub struct Mesh {
     tris: Vec<Tri>,
+    /// Input number (facet in the file, from 0) of each triangle of `tris`.
+    numbers: Vec<usize>,
     index: Bvh,
+    dropped: Dropped,
+}
+
+/// Facets of an STL file its mesh leaves out: zero-area ones (corners collinear to rounding,
+/// [`DEGENERATE_REL`]) and exact repeats of an earlier facet (the same corners in the same turn;
+/// one with its corners in the opposite turn faces the other way and is kept).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Dropped {
+    /// The file.
+    pub file: String,
+    /// Zero-area facets: input number (from 0) and corners.
+    pub degenerate: Vec<(usize, [P3; 3])>,
+    /// Repeated facets: input number and that of the first with the same corners.
+    pub duplicate: Vec<(usize, usize)>,
+}
+
+impl Dropped {
+    /// True when nothing was left out.
+    pub fn is_empty(&self) -> bool {
+        self.degenerate.is_empty() && self.duplicate.is_empty()
+    }
+
+    /// One line saying what was left out, for a warning.
+    pub fn summary(&self) -> String {
+        let mut parts = Vec::new();
+        if let Some((k, _)) = self.degenerate.first() {
+            parts.push(format!("{} zero-area facets (the first facet {})", self.degenerate.len(), k + 1));
+        }
+        if let Some((k, of)) = self.duplicate.first() {
+            parts.push(format!(
+                "{} duplicate facets (the first facet {}, a repeat of facet {})",
+                self.duplicate.len(),
+                k + 1,
+                of + 1
+            ));
+        }
+        format!("{}: {} dropped (--strict refuses them)", self.file, parts.join(" and "))
+    }
+
+    /// The first facet left out as an input error naming it (`--strict`), if any.
+    pub fn refusal(&self) -> Option<Error> {
+        let at = |k: usize| Location::file(&self.file).field(format!("facet {}", k + 1));
+        let degenerate = self.degenerate.first().map(|(k, [a, b, c])| {
+            let e = Error::input(format!(
+                "degenerate triangle (zero area): corners ({}, {}, {}), ({}, {}, {}), ({}, {}, {})",
+                a.x, a.y, a.z, b.x, b.y, b.z, c.x, c.y, c.z
+            ));
+            (*k, e.at(at(*k)))
+        });
+        let duplicate = self.duplicate.first().map(|(k, of)| {
+            (*k, Error::input(format!("duplicate facet: the same corners as facet {}", of + 1)).at(at(*k)))
+        });
+        [degenerate, duplicate].into_iter().flatten().min_by_key(|(k, _)| *k).map(|(_, e)| e)
+    }
 }
 
 /// The result of a mesh query: the foot and the triangle (its number in the input, from 0).
@@ -76,24 +138,72 @@ fn closest_on_triangle(p: &P3, t: &Tri) -> P3 {
 /// squared (its corners are collinear to rounding).
 pub const DEGENERATE_REL: f64 = 1e-12;
 
+/// True when the triangle's area is zero to rounding: twice its area at most [`DEGENERATE_REL`]
+/// times its longest edge squared (or not a number).
+fn degenerate([a, b, c]: &[P3; 3]) -> bool {
+    let (ab, ac) = (b - a, c - a);
+    let cross = ab.cross(&ac).norm();
+    let longest = ab.norm_squared().max(ac.norm_squared()).max((c - b).norm_squared());
+    cross.is_nan() || cross <= DEGENERATE_REL * longest
+}
+
+/// The corners' bits, turned so the smallest corner comes first: equal for the same triangle
+/// given from any corner in the same turn (−0 counts as 0).
+fn facet_key(t: &[P3; 3]) -> [[u64; 3]; 3] {
+    let bits = t.map(|p| [p.x, p.y, p.z].map(|v| (v + 0.0).to_bits()));
+    let first = (0..3).min_by_key(|&i| bits[i]).expect("three corners");
+    [bits[first], bits[(first + 1) % 3], bits[(first + 2) % 3]]
+}
+
 impl Mesh {
     /// A mesh from corner triples; `Err(k)` names the first degenerate triangle.
     pub fn new(triangles: &[[P3; 3]]) -> std::result::Result<Mesh, usize> {
+        if let Some(k) = triangles.iter().position(degenerate) {
+            return Err(k);
+        }
+        Ok(Mesh::build(triangles, (0..triangles.len()).collect(), Dropped::default()))
+    }
+
+    /// A mesh of STL facets: zero-area and repeated ones left out and listed (`file` names them).
+    pub fn of_facets(facets: &[[P3; 3]], file: &str) -> Mesh {
+        let mut dropped = Dropped { file: file.to_string(), ..Dropped::default() };
+        let mut first = std::collections::HashMap::with_capacity(facets.len());
+        let (mut kept, mut numbers) = (Vec::with_capacity(facets.len()), Vec::with_capacity(facets.len()));
+        for (k, t) in facets.iter().enumerate() {
+            if degenerate(t) {
+                dropped.degenerate.push((k, *t));
+                continue;
+            }
+            match first.entry(facet_key(t)) {
+                std::collections::hash_map::Entry::Occupied(e) => dropped.duplicate.push((k, *e.get())),
+                std::collections::hash_map::Entry::Vacant(e) => {
+                    e.insert(k);
+                    kept.push(*t);
+                    numbers.push(k);
+                }
+            }
+        }
+        Mesh::build(&kept, numbers, dropped)
+    }
+
+    /// The mesh of non-degenerate triangles whose input numbers are `numbers`.
+    fn build(triangles: &[[P3; 3]], numbers: Vec<usize>, dropped: Dropped) -> Mesh {
         let mut tris = Vec::with_capacity(triangles.len());
         let mut boxes = Vec::with_capacity(triangles.len());
-        for (k, [a, b, c]) in triangles.iter().enumerate() {
+        for [a, b, c] in triangles {
             let (ab, ac) = (b - a, c - a);
-            let cross = ab.cross(&ac);
-            let longest = ab.norm_squared().max(ac.norm_squared()).max((c - b).norm_squared());
-            if cross.norm().is_nan() || cross.norm() <= DEGENERATE_REL * longest {
-                return Err(k);
-            }
-            tris.push(Tri { a: *a, ab, ac, n: cross.normalize() });
+            tris.push(Tri { a: *a, ab, ac, n: ab.cross(&ac).normalize() });
             boxes.push(Aabb::of(&[*a, *b, *c]));
         }
         let index = Bvh::build(&boxes);
         let tris = index.order.iter().map(|&i| tris[i as usize]).collect();
-        Ok(Mesh { tris, index })
+        let numbers = index.order.iter().map(|&i| numbers[i as usize]).collect();
+        Mesh { tris, numbers, index, dropped }
+    }
+
+    /// The facets of the file left out of the mesh.
+    pub fn dropped(&self) -> &Dropped {
+        &self.dropped
     }
 
     /// Number of triangles.
@@ -135,7 +245,7 @@ impl Mesh {
             e
         });
         let (k, _, point, _) = best?;
-        Some(MeshFoot { foot: Foot { point, normal: self.tris[k].n }, triangle: self.index.order[k] as usize })
+        Some(MeshFoot { foot: Foot { point, normal: self.tris[k].n }, triangle: self.numbers[k] })
     }
 
     /// Every triangle's corners, in the index's order (for brute-force checks and exports).
@@ -240,17 +350,19 @@ fn ascii_facet_line(data: &[u8], k: usize) -> u64 {
     last
 }
 
-/// Reads an STL file and builds its mesh; a degenerate triangle is an input error naming it.
+/// Reads an STL file and builds its mesh, zero-area and repeated facets left out and listed
+/// ([`Mesh::dropped`]); a file with nothing else is an input error.
 pub fn load_stl(input: &Input) -> Result<Mesh> {
     let corners = read_stl(input)?;
-    Mesh::new(&corners).map_err(|k| {
-        let [a, b, c] = corners[k];
-        Error::input(format!(
-            "degenerate triangle (zero area): corners ({}, {}, {}), ({}, {}, {}), ({}, {}, {})",
-            a.x, a.y, a.z, b.x, b.y, b.z, c.x, c.y, c.z
+    let mesh = Mesh::of_facets(&corners, &input.name);
+    if mesh.is_empty() {
+        return Err(Error::input(format!(
+            "all {} facets are degenerate (zero area) or repeats: no surface is left",
+            corners.len()
         ))
-        .at(Location::file(&input.name).field(format!("facet {}", k + 1)))
-    })
+        .at(Location::file(&input.name)));
+    }
+    Ok(mesh)
 }
 
 /// Binary STL bytes of the triangles (normals from the corners' order), for tests and tools.
@@ -330,7 +442,7 @@ mod tests {
         assert!(e.to_string().starts_with("t.stl:9 (facet 2): malformed STL"), "{e}");
         let flat = vec![[P3::origin(), P3::new(1.0, 0.0, 0.0), P3::new(2.0, 0.0, 0.0)]];
         let e = load_stl(&input("d.stl", binary_stl(&flat))).unwrap_err();
-        assert!(e.to_string().starts_with("d.stl (facet 1): degenerate triangle"), "{e}");
+        assert!(e.to_string().starts_with("d.stl: all 1 facets are degenerate"), "{e}");
     }
 
     /// A header that counts fewer triangles than the file holds: all are read; bytes after them
@@ -351,5 +463,39 @@ mod tests {
         );
         let ascii = "\u{feff}solid t\nfacet normal 0 0 1\n outer loop\n  vertex 0 0 0\n  vertex 1 0 0\n  vertex 0 1 0\n endloop\nendfacet\nendsolid t\n";
         assert_eq!(read_stl(&input("bom.stl", ascii.as_bytes().to_vec())).unwrap().len(), 1);
+    }
+
+    /// An OpenSCAD-style STL: a closed box of 12 facets with zero-area slivers (collinear
+    /// corners, a repeated corner) and repeated facets (one from another corner) among them.
+    /// They are left out and listed; nearest points are those of the box; the facet numbers
+    /// reported are the file's.
+    #[test]
+    fn slivers_and_repeats_are_dropped_and_listed() {
+        let c = |i: usize| P3::new([0.0, 10.0][i & 1], [0.0, 8.0][(i >> 1) & 1], [0.0, 5.0][(i >> 2) & 1]);
+        let quads = [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]];
+        let boxed: Vec<[P3; 3]> =
+            quads.iter().flat_map(|q| [[c(q[0]), c(q[1]), c(q[2])], [c(q[0]), c(q[2]), c(q[3])]]).collect();
+        let mut facets = boxed.clone();
+        facets.insert(3, [c(4), P3::new(5.0, 0.0, 5.0), c(5)]);
+        facets.insert(7, [c(6), c(6), c(7)]);
+        facets.push(boxed[5]);
+        facets.push([boxed[0][1], boxed[0][2], boxed[0][0]]);
+        facets.push([boxed[0][0], boxed[0][2], boxed[0][1]]);
+        let mesh = load_stl(&input("scad.stl", binary_stl(&facets))).unwrap();
+        let d = mesh.dropped();
+        assert_eq!(d.degenerate.iter().map(|(k, _)| *k).collect::<Vec<_>>(), vec![3, 7]);
+        assert_eq!(d.duplicate, vec![(14, 6), (15, 0)]);
+        assert_eq!(mesh.len(), 13, "the box and the reversed repeat, which faces the other way");
+        assert_eq!(
+            d.summary(),
+            "scad.stl: 2 zero-area facets (the first facet 4) and 2 duplicate facets (the first facet 15, a repeat of facet 7) dropped (--strict refuses them)"
+        );
+        assert!(d.refusal().unwrap().to_string().starts_with("scad.stl (facet 4): degenerate triangle (zero area)"));
+        let q = P3::new(5.0, 4.0, 9.0);
+        let foot = mesh.nearest(&q, f64::INFINITY).unwrap();
+        assert!((foot.foot.point - P3::new(5.0, 4.0, 5.0)).norm() < 1e-12 && foot.foot.normal == V3::z());
+        assert!([2, 4].contains(&foot.triangle), "the file's number of a top facet: {}", foot.triangle);
+        let clean = load_stl(&input("box.stl", binary_stl(&boxed))).unwrap();
+        assert!(clean.dropped().is_empty() && clean.dropped().refusal().is_none());
     }
 }

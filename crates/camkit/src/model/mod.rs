@@ -209,6 +209,33 @@ impl Model {
         self.surfaces.iter().map(|s| if let Geometry::Mesh(m) = &s.geometry { m.len() } else { 0 }).sum()
     }
 
+    /// What the model's STL files held that their meshes leave out, one entry per file that had
+    /// any (see [`mesh::Dropped`]).
+    pub fn dropped(&self) -> Vec<&mesh::Dropped> {
+        self.surfaces
+            .iter()
+            .filter_map(|s| if let Geometry::Mesh(m) = &s.geometry { Some(m.dropped()) } else { None })
+            .filter(|d| !d.is_empty())
+            .collect()
+    }
+
+    /// Zero-area and repeated STL facets left out, over all meshes: the report's counts.
+    pub fn dropped_counts(&self) -> (usize, usize) {
+        self.dropped().iter().fold((0, 0), |(a, b), d| (a + d.degenerate.len(), b + d.duplicate.len()))
+    }
+
+    /// STL facets left out: with `strict` the first is an input error naming its file and facet;
+    /// else a warning for each file that had any (one line).
+    pub fn check_dropped(&self, strict: bool) -> Result<()> {
+        for d in self.dropped() {
+            if strict {
+                return Err(d.refusal().expect("something was dropped"));
+            }
+            crate::cli::warn(&d.summary());
+        }
+        Ok(())
+    }
+
     /// Reads a model: a model document (`.json`), or one STL file (`.stl`) as a one-surface
     /// model. STL files named in a document are found relative to it.
     pub fn load(input: &Input) -> Result<Model> {
