@@ -296,6 +296,11 @@ fn pipelines_to_six_axis_nc() {
         w.run(BIN, &["--tool", tool.to_str().unwrap(), "--model", model, "--report", "r.json"], cl.as_bytes()).ok();
     let report: serde_json::Value = serde_json::from_str(&w.read("r.json")).unwrap();
     assert_eq!(report["gouge_rows"], 0);
+    // The flanks' wedge against the solid (was 16 probes a flank): the flank on the B-spline keeps
+    // the stylus radius off to within its largest gouge, 0.82 µm (the probes: 0.826 µm).
+    assert_eq!(report["gouge_check"], "body");
+    let largest = report["largest_gouge_mm"].as_f64().unwrap();
+    assert!(largest > 0.0005 && largest < 0.001, "largest gouge {largest}");
     assert!(report["flank_gap_min_deg"].as_f64().unwrap() > 4.0);
     w.write("tool2.csv", &out);
     let machine = data("post-6axis/paper000-sixaxis-m19.json");

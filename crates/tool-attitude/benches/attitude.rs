@@ -40,7 +40,7 @@ fn bench(c: &mut Criterion) {
     let tool = r#"{"kind": "cylindrical-nonrotating", "radius": 12.5}"#;
     let tool: camkit::doc::Tool =
         camkit::json::from_input(&Input { name: "tool.json".into(), data: tool.as_bytes().to_vec() }).unwrap();
-    let part = Part::new(model, &tool, 50.0, 2.5e-4, true).unwrap();
+    let part = Part::new(model, &tool, 50.0, 2.5e-4).unwrap();
     for (name, m) in [("cylinder_1000_rows", None), ("cylinder_1000_rows_gouge_check", Some(&part))] {
         c.bench_function(name, |b| {
             b.iter(|| cs.iter().map(|ct| attitude(&setup, ct, m).unwrap().pose.tip.x).sum::<f64>())

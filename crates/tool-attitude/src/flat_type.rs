@@ -114,7 +114,8 @@ pub fn solve(
 /// two-surface contact criterion, 0.1 µm.
 pub const CONTROL_TOL: f64 = 1e-7;
 
-/// The second flank's direction of a solved pose (unit, from P2), for gouge probes and tests.
+/// Both flanks' directions of a solved pose (unit, from P2): the first toward the control point,
+/// the second the included angle from it through the axis (the wedge the gouge check places).
 pub fn flanks(p: &FlatPose, edge: &Edge) -> (V3, V3) {
     let a = p.pose.axis;
     let first = (p.control_point - p.pose.tip).normalize();

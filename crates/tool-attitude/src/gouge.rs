@@ -1,85 +1,54 @@
 //! Gouge checks: the whole tool body as an exact solid against the part (camkit's
-//! [`Solid::clearance`]: every overlap of the body with the model is found, not samples of it),
-//! the flat-type tool's flank probes, and the search for the tilt nearest the requested one,
-//! inside the allowed range, at which the body does not cut in.
+//! [`Solid::clearance`]: every overlap of the body with the model is found, not samples of it;
+//! the flat-type tool's body is the thin wedge of its two flanks), and the search for the tilt
+//! nearest the requested one, inside the allowed range, at which the body does not cut in.
 
 use crate::pose::Pose;
 use camkit::collide::solid::{Body, Placement, Solid};
 use camkit::doc::Tool;
-use camkit::geom::P3;
 use camkit::model::Model;
 
-/// The part a pose is checked against: the model, and for a tool with a body (cylinder, ball,
-/// flat end mill) that body and the model as a solid.
+/// The part a pose is checked against: the model, the tool's body (cylinder, ball, flat end mill,
+/// the flat-type tool's wedge of its flanks) and the model as a solid.
 pub struct Part {
-    /// The model (nearest-point queries: the flat-type correction and its flank probes).
+    /// The model (nearest-point queries: the flat-type correction).
     pub model: Model,
-    body: Option<(Solid, Body)>,
+    solid: Solid,
+    body: Body,
 }
 
 impl Part {
-    /// The part for `tool` whose body reaches `length` above its tip; with `solid`, the model as
-    /// a solid (B-spline patches, bounded flipped cylinders, cones and tori as triangles within
-    /// `chord` mm; see [`Solid::of_any`]). An error names the surface the solid cannot take.
-    pub fn new(model: Model, tool: &Tool, length: f64, chord: f64, solid: bool) -> Result<Part, String> {
-        let body = if solid {
-            let body = Body::of(&Tool { length: Some(length), ..tool.clone() });
-            Some((Solid::of_any(&model, chord)?, body))
-        } else {
-            None
-        };
-        Ok(Part { model, body })
+    /// The part for `tool` whose body reaches `length` above its tip (the flat-type tool's wedge
+    /// reaches its `flank_length` along each flank instead), with the model as a solid (B-spline
+    /// patches, bounded flipped cylinders, cones and tori as triangles within `chord` mm; see
+    /// [`Solid::of_any`]). An error names the surface the solid cannot take.
+    pub fn new(model: Model, tool: &Tool, length: f64, chord: f64) -> Result<Part, String> {
+        let body = Body::of(&Tool { length: Some(length), ..tool.clone() });
+        let solid = Solid::of_any(&model, chord)?;
+        Ok(Part { model, solid, body })
     }
 
     /// Largest distance (mm) between a tessellated surface and its triangles: each penetration
     /// is exact against the triangles, so within this of the surface's own (0: exact surfaces).
     pub fn chord_error(&self) -> f64 {
-        self.body.as_ref().map_or(0.0, |(s, _)| s.chord_error())
+        self.solid.chord_error()
     }
 
     /// How deep the tool body at `pose` cuts into the part (mm, 0 when clear): the penetration
     /// depth of the body into the solid (for a mesh, the deepest overlap with one of its
-    /// triangles, or the tip's depth inside a closed mesh). 0 for a part without a body.
+    /// triangles, or the tip's depth inside a closed mesh).
     pub fn penetration(&self, pose: &Pose) -> f64 {
-        self.body.as_ref().map_or(0.0, |(solid, body)| {
-            let at = Placement { tip: pose.tip, axis: pose.axis, edge: pose.edge };
-            (-solid.clearance(body, &at, 0.0)).max(0.0)
-        })
+        self.penetration_within(pose, 0.0)
     }
-}
 
-/// A point of the flat-type tool's flanks and how far outside the model it must stay (mm).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Probe {
-    /// The point.
-    pub point: P3,
-    /// Required signed distance to the model (the stylus radius: the edge is the stylus's
-    /// offset of the surface).
-    pub clearance: f64,
-}
-
-/// Probes along the flat-type tool's two flanks from the tip, each to stay the stylus radius `r`
-/// away (the edge is the stylus's offset of the surface).
-pub fn flank_probes(tip: &P3, flanks: (camkit::geom::V3, camkit::geom::V3), length: f64, r: f64) -> Vec<Probe> {
-    let count = 16;
-    let mut out = Vec::with_capacity(2 * count);
-    for f in [flanks.0, flanks.1] {
-        for k in 1..=count {
-            out.push(Probe { point: tip + f * (length * k as f64 / count as f64), clearance: r });
-        }
+    /// How far the tool body at `pose` comes inside `stand_off` mm of the part (mm, 0 when it
+    /// keeps that far off): `stand_off` less the signed clearance. The flat-type tool's edge is
+    /// the stylus's offset of the surface, so its wedge must keep the stylus radius off. The
+    /// body is placed with its edge (tool +X, across the wedge's plane) along `pose.edge`.
+    pub fn penetration_within(&self, pose: &Pose, stand_off: f64) -> f64 {
+        let at = Placement { tip: pose.tip, axis: pose.axis, edge: pose.edge };
+        (stand_off - self.solid.clearance(&self.body, &at, stand_off)).max(0.0)
     }
-    out
-}
-
-/// Signed distance from `q` to the model: negative inside (behind the outward normal).
-pub fn signed_distance(model: &Model, q: &P3) -> f64 {
-    let n = model.nearest(q);
-    if (q - n.point).dot(&n.normal) < 0.0 { -n.distance } else { n.distance }
-}
-
-/// How deep the deepest probe cuts into its clearance (mm, 0 when none does).
-pub fn penetration(model: &Model, probes: &[Probe]) -> f64 {
-    probes.iter().map(|p| p.clearance - signed_distance(model, &p.point)).fold(0.0, f64::max)
 }
 
 /// Outcome of the tilt search.
@@ -134,7 +103,7 @@ pub const ADJUST_ANGLE_TOL: f64 = 1e-7;
 #[cfg(test)]
 mod tests {
     use super::*;
-    use camkit::geom::V3;
+    use camkit::geom::{P3, V3};
     use camkit::model::analytic::Analytic;
     use camkit::model::mesh::Mesh;
     use camkit::model::{Geometry, Surface};
@@ -202,10 +171,126 @@ mod tests {
                 name: "t.json".into(),
                 data: br#"{"kind": "cylindrical-nonrotating", "radius": 12.5}"#.to_vec(),
             }).unwrap();
-            let part = Part::new(model, &tool, 40.0, 1e-4, true).unwrap();
+            let part = Part::new(model, &tool, 40.0, 1e-4).unwrap();
             let got = part.penetration(&pose);
             let sagitta = r * (1.0 - (std::f64::consts::PI / n as f64).cos());
             prop_assert!((got - exact.max(0.0)).abs() <= sagitta + 1e-6, "gouge {got}, exact {exact}");
+        }
+    }
+
+    /// A tool document from JSON text.
+    fn tool(json: &str) -> Tool {
+        camkit::json::from_input(&camkit::io::Input { name: "t.json".into(), data: json.as_bytes().to_vec() }).unwrap()
+    }
+
+    /// A surface of `geometry`, not flipped.
+    fn surface(name: &str, geometry: Geometry) -> Surface {
+        Surface::new(name.into(), geometry, None, false)
+    }
+
+    /// The flat-type tool's body is the wedge of the flanks `flat_type::solve` computes: a small
+    /// ball 0.3 mm beyond either flank's end (along the flank, so its nearest point of the wedge
+    /// is that corner) stands exactly 0.3 − 0.1 from the body, in a skew corner where the
+    /// wedge's plane, its half angle and its edge direction all matter.
+    #[test]
+    fn flat_type_wedge_corners_are_the_flanks() {
+        let nc = V3::new(0.2, 0.1, 1.0).normalize();
+        let other = V3::new(1.0, -0.3, 0.2).normalize();
+        let corner = crate::flat_type::Corner {
+            centre: P3::new(3.0, -2.0, 5.0),
+            control: (P3::new(3.0, -2.0, 5.0) - nc, nc),
+            other,
+        };
+        let edge = crate::flat_type::Edge { included: 65f64.to_radians(), flank: 1.5 };
+        let fp = crate::flat_type::solve(&corner, &edge, &V3::new(0.3, 1.0, -0.2), None).unwrap();
+        let (first, second) = crate::flat_type::flanks(&fp, &edge);
+        let t = tool(r#"{"kind": "flat-nonrotating", "radius": 5, "included_angle": 65, "flank_length": 1.5}"#);
+        for f in [first, second] {
+            let centre = fp.pose.tip + f * (edge.flank + 0.3);
+            let model =
+                Model { surfaces: vec![surface("ball", Geometry::Analytic(Analytic::Sphere { centre, radius: 0.1 }))] };
+            let part = Part::new(model, &t, 30.0, 1e-4).unwrap();
+            let got = part.penetration_within(&fp.pose, 1.0);
+            assert!((got - 0.8).abs() < 1e-9, "flank {f:?}: {got}");
+        }
+    }
+
+    /// A thin rod (radius 0.5) on the floor of a square corner, across the flat-type tool's
+    /// first flank (32 mm long: the old 16 probes 2 mm apart) midway between two of the old
+    /// probes. The probes all stand more than the stylus radius off the rod (the old check
+    /// reported no gouge); the wedge check finds it at the depth an independent closed form
+    /// gives: stylus radius + rod radius − the segment-to-line distance from the flank to the
+    /// rod's axis.
+    #[test]
+    fn thin_rod_between_flank_probes_is_found() {
+        let (r, rod, flank, count) = (0.25, 0.5, 32.0, 16);
+        let t = tool(r#"{"kind": "flat-nonrotating", "radius": 5, "included_angle": 85, "flank_length": 32}"#);
+        let setup = crate::Setup {
+            shape: crate::Shape::FlatType {
+                edge: crate::flat_type::Edge { included: 85f64.to_radians(), flank },
+                control_second: false,
+            },
+            tilt: 0.0,
+            range: (0.0, 0.0),
+            length: 30.0,
+            gouge_tol: 1e-3,
+        };
+        let contact = crate::Contact {
+            centre: P3::new(r, 0.0, r),
+            point: P3::new(r, 0.0, 0.0),
+            normal: V3::z(),
+            second: Some((P3::new(0.0, 0.0, r), V3::x())),
+            surfaces: (Some(0), Some(1)),
+            feed: V3::y(),
+        };
+        let plane = |normal: V3| Geometry::Analytic(Analytic::Plane { point: P3::origin(), normal });
+        // (probe interval, angle of the rod from the flank in degrees, rod axis below the flank).
+        for (k, phi, below) in [(5, 90.0, 0.3), (9, 70.0, 0.3), (2, 110.0, 0.6), (12, 90.0, 0.9)] {
+            let phi: f64 = f64::to_radians(phi);
+            let d = V3::new(phi.cos(), phi.sin(), 0.0);
+            let step = flank / count as f64;
+            let b = P3::new(r + step * (k as f64 + 0.5), 0.0, r - below);
+            let model = Model {
+                surfaces: vec![
+                    surface("floor", plane(V3::z())),
+                    surface("wall", plane(V3::x())),
+                    surface(
+                        "rod",
+                        Geometry::Analytic(Analytic::Cylinder {
+                            point: b,
+                            axis: d,
+                            radius: rod,
+                            from: -200.0,
+                            to: 200.0,
+                        }),
+                    ),
+                ],
+            };
+            let part = Part::new(model, &t, 30.0, 1e-4).unwrap();
+            let a = crate::attitude(&setup, &contact, Some(&part)).unwrap();
+            let (first, _) = crate::flat_type::flanks(
+                &crate::flat_type::FlatPose {
+                    pose: a.pose,
+                    correction: 0.0,
+                    corner_angle: 0.0,
+                    flank_gap: 0.0,
+                    control_point: a.pose.tip + V3::x() * flank,
+                },
+                &crate::flat_type::Edge { included: 85f64.to_radians(), flank },
+            );
+            assert!((first - V3::x()).norm() < 1e-12 && (a.pose.tip - contact.centre).norm() < 1e-12);
+            // The old probes: every one more than r off the rod's surface.
+            for j in 1..=count {
+                let q = a.pose.tip + first * (step * j as f64);
+                let w = q - b;
+                let off = (w - d * w.dot(&d)).norm() - rod;
+                assert!(off > r, "probe {j} is {off} off the rod");
+            }
+            let (s, dist) = segment_line(&a.pose.tip, &first, &b, &d);
+            assert!(s > 0.0 && s < flank);
+            let exact = (r + rod - dist).max(0.0);
+            let got = a.gouge.unwrap();
+            assert!((got - exact).abs() < 1e-6, "rod {k}: gouge {got}, exact {exact}");
         }
     }
 

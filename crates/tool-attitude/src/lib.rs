@@ -184,10 +184,10 @@ pub fn attitude(setup: &Setup, c: &Contact, part: Option<&Part>) -> Result<Attit
             let dist = model.zip(index).map(|(m, i)| move |q: &P3| m.nearest_on(q, i).distance);
             let dist_ref = dist.as_ref().map(|d| d as &dyn Fn(&P3) -> f64);
             let fp = flat_type::solve(&corner, &edge, &c.feed, dist_ref).map_err(RowError::Flat)?;
+            // The edge is the stylus's offset of the surface: the wedge of both flanks (at the
+            // tip, in the plane across the corner line `fp.pose.edge`) keeps the stylus radius off.
             let r = (c.centre - control.0).norm();
-            let gouge = model.map(|m| {
-                gouge::penetration(m, &gouge::flank_probes(&fp.pose.tip, flat_type::flanks(&fp, &edge), edge.flank, r))
-            });
+            let gouge = part.map(|p| p.penetration_within(&fp.pose, r));
             Ok(Attitude {
                 pose: fp.pose,
                 tilt: fp.correction + (edge.included - fp.corner_angle) / 2.0,

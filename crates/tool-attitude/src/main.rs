@@ -313,7 +313,7 @@ fn run_fixed(args: &Args, tool: &Tool, tool_file: &str, axis: V3, started: Insta
     }
     let r = tool.radius;
     let length = tool.length.unwrap_or(4.0 * r);
-    let part = load_part(args, tool, length, true)?;
+    let part = load_part(args, tool, length)?;
     t.schema.add(&[Col::I, Col::J, Col::K]);
     let c_gouge = part.is_some().then(|| t.add_extra_column("gouge"));
     let gouges: Vec<f64> = t
@@ -378,8 +378,7 @@ fn run(args: Args) -> Result<()> {
         return run_fixed(&args, &tool, &tool_input.name, axis, started);
     }
     let setup = setup(&args, &tool, &tool_input.name)?;
-    let solid = !matches!(setup.shape, Shape::FlatType { .. });
-    let part = load_part(&args, &tool, setup.length, solid)?;
+    let part = load_part(&args, &tool, setup.length)?;
     let model = part.as_ref().map(|p| &p.model);
     let input = Input::open(&args.io.input)?;
     let mut t = table::read(&input, &[Col::X, Col::Y, Col::Z, Col::Px, Col::Py, Col::Pz, Col::Nx, Col::Ny, Col::Nz])?;
@@ -471,7 +470,7 @@ fn run(args: Args) -> Result<()> {
         .set("gouge_lines", gouging.iter().take(20).map(|&k| t.rows[k].line).collect::<Vec<_>>())
         .set("gouge_tol_mm", setup.gouge_tol)
         .set("largest_gouge_mm", poses.iter().filter_map(|a| a.gouge).fold(0.0, f64::max))
-        .set("gouge_check", part.as_ref().map(|_| if solid { "body" } else { "flank-probes" }))
+        .set("gouge_check", part.as_ref().map(|_| "body"))
         .set("gouge_chord_mm", part.as_ref().map(Part::chord_error))
         .set("largest_axis_unit_error", checks.unit)
         .set("largest_tilt_error_rad", checks.tilt)
@@ -498,16 +497,16 @@ fn run(args: Args) -> Result<()> {
     deliver(&args, &t, &input.name, &gouging, setup.gouge_tol, largest)
 }
 
-/// The part of `--model` (none without): the model, and with `solid` the tool body of `length`
-/// and the model as a solid, its tessellated surfaces within a quarter of --gouge-tol (at least
+/// The part of `--model` (none without): the model, the tool body of `length` and the model as
+/// a solid, its tessellated surfaces within a quarter of --gouge-tol (at least
 /// 1e-6 mm, at most 2 µm).
-fn load_part(args: &Args, tool: &Tool, length: f64, solid: bool) -> Result<Option<Part>> {
+fn load_part(args: &Args, tool: &Tool, length: f64) -> Result<Option<Part>> {
     let Some(file) = &args.model else { return Ok(None) };
     let model = Model::load(&Input::open(file)?)?;
     // Its STL files' dropped facets warned about (or refused with --strict).
     model.check_dropped(args.strict)?;
     let chord = (0.25 * args.gouge_tol).clamp(1e-6, 0.002);
-    Part::new(model, tool, length, chord, solid).map(Some).map_err(|e| Error::input(e).at(Location::file(file)))
+    Part::new(model, tool, length, chord).map(Some).map_err(|e| Error::input(e).at(Location::file(file)))
 }
 
 /// Writes the table, after rows that gouge (indices `gouging`, the deepest `largest` mm) fail the
