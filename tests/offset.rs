@@ -771,3 +771,41 @@ fn a_pocket_exactly_2r_wide_is_cut_along_its_centre_line() {
     run.ok();
     assert!(run.stderr.contains("does not fit"), "{}", run.stderr);
 }
+
+/// Issue 20: a run whose memory follows from its options (passes at the step over, points of a
+/// corner polygon) is estimated before it starts and refused past `--max-memory`, at once,
+/// naming the option and the estimate: a step of 1e-6 mm ran for hours, a `--chord-tol` of
+/// 1e-300 aborted on a 4 GiB allocation.
+#[test]
+fn runs_past_the_memory_bound_are_refused_up_front() {
+    let w = Work::new();
+    w.write(
+        "island.csv",
+        "path,move,x,y,z\n1,rapid,0,0,0\n1,line,60,0,0\n1,line,60,40,0\n1,line,0,40,0\n1,line,0,0,0\n\
+         2,rapid,24,16,0\n2,line,24,24,0\n2,line,36,24,0\n2,line,36,16,0\n2,line,24,16,0\n",
+    );
+    let mut csv = String::from("path,move,x,y,z,i,j,k\n");
+    for k in 0..=40 {
+        let t = TAU * (k % 40) as f64 / 40.0;
+        let mv = if k == 0 { "rapid" } else { "line" };
+        csv.push_str(&format!("0,{mv},{},{},0,0,0,1\n", 20.0 * t.cos(), 20.0 * t.sin()));
+    }
+    w.write("ring.csv", csv);
+    let started = std::time::Instant::now();
+    let cases: [(&[&str], &str); 4] = [
+        (&["island.csv", "--radius", "2", "--until-empty", "--step", "1e-6"], "--step 0.000001 mm needs an estimated"),
+        (&["island.csv", "--radius", "2", "--repeat", "1000000000", "--step", "1e-6"], "--max-memory"),
+        (&["ring.csv", "--3d", "--radius", "0.1", "--side", "right", "--chord-tol", "1e-300"], "--chord-tol 1e-300 mm"),
+        (&["island.csv", "--radius", "2", "--until-empty", "--max-memory", "0"], "more than the bound of 0 MB"),
+    ];
+    for (args, needle) in cases {
+        let mut a = args.to_vec();
+        a.extend(["-o", "out.csv"]);
+        w.run(BIN, &a, b"").fails(2, needle);
+        assert!(!w.exists("out.csv"));
+    }
+    assert!(started.elapsed().as_secs_f64() < 10.0, "refused at once: {:?}", started.elapsed());
+    // Within the bound the same runs go ahead.
+    w.run(BIN, &["island.csv", "--radius", "2", "--until-empty", "--step", "1"], b"").ok();
+    w.run(BIN, &["ring.csv", "--3d", "--radius", "0.1", "--side", "right", "--chord-tol", "1e-9"], b"").ok();
+}

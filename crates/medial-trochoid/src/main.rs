@@ -151,6 +151,10 @@ struct Args {
     /// engagement column.
     #[arg(long, value_name = "FILE")]
     analyse: Option<PathBuf>,
+    /// Largest memory a plan may hold (MB), estimated from the pocket, --step, --sample,
+    /// --pitch, --sagitta and the layers before planning; larger plans are refused (exit 2).
+    #[arg(long, default_value_t = camkit::budget::DEFAULT_MEMORY_MB, value_name = "MB")]
+    max_memory: u64,
 }
 
 fn after_help() -> String {
@@ -305,6 +309,20 @@ fn run(args: Args) -> Result<()> {
             chorded.len()
         ));
     }
+    let (z0, layer_count, layer_depth) = layering(job.as_ref(), sources[0].z, args.layers, args.layer_depth)?;
+    camkit::budget::check_memory(
+        medial_trochoid::budget::memory(&regions, &settings, layer_count),
+        camkit::budget::bytes_of(args.max_memory),
+        &format!(
+            "the plan (--step {} mm, --sample {} mm, {layer_count} layers, --trochoid-radius {} mm{}, --sagitta {} mm)",
+            cli::short(step),
+            cli::short(settings.sample),
+            cli::short(rt),
+            args.pitch.map(|p| format!(", --pitch {} mm", cli::short(p))).unwrap_or_default(),
+            cli::short(args.sagitta)
+        ),
+        "coarsen --step, --sample, --pitch or --sagitta, use fewer layers",
+    )?;
     let leave_uncut = !(args.no_leave_uncut || args.allow_over_threshold);
     // Planned that much farther from the walls that the written program, rounded to
     // --decimals, still keeps R + allowance; checked below on the rounded rows.
@@ -326,7 +344,6 @@ fn run(args: Args) -> Result<()> {
         _ => Error::input(e.to_string()).at(Location::file(&name)),
     })?;
     let chosen = if args.program == Which::Trochoid { &plan.trochoidal } else { &plan.offset_only };
-    let (z0, layer_count, layer_depth) = layering(job.as_ref(), sources[0].z, args.layers, args.layer_depth)?;
     let out_table = to_table(chosen, z0, layer_count, layer_depth);
     // The program as written (rounded to --decimals) read back and simulated again: the
     // report's figures of the written program are this check's, as --analyse gives them.

@@ -9,6 +9,7 @@
 //!
 //! The 2D kernel is `camkit::contour` (cavalier_contours, verified with exact distances).
 
+pub mod budget;
 pub mod contours;
 pub mod plot;
 pub mod profile;
