@@ -274,3 +274,25 @@ fn closed_output_pipe_is_not_an_error() {
     assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
     assert!(out.stderr.is_empty(), "{}", String::from_utf8_lossy(&out.stderr));
 }
+
+/// Issue 20: every numeric option at extreme values, seeded (scripts/fuzz-options.py runs them
+/// all): no panic, exit 0/1/2, one error line, under 20 s and 4 GiB.
+#[test]
+fn extreme_option_values_end_in_time_with_one_line() {
+    let w = Work::new();
+    let points: String =
+        (0..200).map(|k| format!("{},{:.6}\n", k as f64 * 0.5, (k as f64 * 0.05).sin() * 10.0)).collect();
+    w.write("points.csv", format!("x,y\n{points}"));
+    let options = [
+        "--tol",
+        "--min-radius",
+        "--max-radius",
+        "--max-sweep",
+        "--tangent",
+        "--corner",
+        "--curvature-threshold",
+        "--e-rate-tol",
+        "--decimals",
+    ];
+    w.fuzz_options(BIN, "points.csv", &[], &options, 20, 12);
+}

@@ -1006,5 +1006,38 @@ fn plans_past_the_memory_bound_are_refused_up_front() {
     let circle = data("medial-trochoid/circle15.csv");
     w.run(BIN, &[circle.to_str().unwrap(), "--radius", "5", "--sagitta", "1e-300"], b"")
         .fails(2, "--sagitta 1e-300 mm");
+    // Chords finer than the snap grid: refused (a run at 1e-9 on the square did not end).
+    w.run(BIN, &[src, "--radius", "5", "--sagitta", "1e-9"], b"")
+        .fails(2, "--sagitta 1e-9 mm is below the Voronoi snap grid");
     assert!(started.elapsed().as_secs_f64() < 10.0, "refused at once: {:?}", started.elapsed());
+}
+
+/// Issue 20: every numeric option at extreme values, seeded (scripts/fuzz-options.py runs them
+/// all): no panic, exit 0/1/2, one error line, under 20 s and 4 GiB.
+#[test]
+fn extreme_option_values_end_in_time_with_one_line() {
+    let w = Work::new();
+    let src = data("medial-trochoid/square.csv");
+    let options = [
+        "--radius",
+        "--step",
+        "--threshold",
+        "--trochoid-radius",
+        "--pitch",
+        "--allowance",
+        "--corner-radius",
+        "--sample",
+        "--layers",
+        "--layer-depth",
+        "--resolution",
+        "--sagitta",
+        "--spindle",
+        "--teeth",
+        "--chip",
+        "--fz-max",
+        "--force-at",
+        "--decimals",
+        "--max-memory",
+    ];
+    w.fuzz_options(BIN, src.to_str().unwrap(), &["--radius", "5", "--sample", "2"], &options, 20, 12);
 }

@@ -186,7 +186,7 @@ fn after_help() -> String {
 }
 
 fn main() -> ExitCode {
-    cli::run("medial-trochoid", || run(Args::parse()))
+    cli::run("medial-trochoid", || run(cli::parse::<Args>()?))
 }
 
 /// The first layer's bottom, the number of layers and their depth: from the stock top down to
@@ -248,6 +248,15 @@ fn run(args: Args) -> Result<()> {
     }
     if !(args.layer_depth.is_finite() && args.layer_depth >= 0.0) || args.layers == Some(0) {
         return Err(Error::input("--layers must be at least 1 and --layer-depth zero or more"));
+    }
+    // Chords finer than the snap grid are lost in the snapping, and there would be unboundedly
+    // many of them (a run at --sagitta 1e-9 on a 60 × 40 square did not end).
+    if args.sagitta < args.resolution {
+        return Err(Error::input(format!(
+            "--sagitta {} mm is below the Voronoi snap grid (--resolution {} mm): chords that fine are lost in the snapping",
+            cli::short(args.sagitta),
+            cli::short(args.resolution)
+        )));
     }
     let settings = Settings {
         radius: r,

@@ -149,7 +149,7 @@ fn after_help() -> String {
 }
 
 fn main() -> ExitCode {
-    cli::run("offset", || run(Args::parse()))
+    cli::run("offset", || run(cli::parse::<Args>()?))
 }
 
 fn side(args: &Args, needed: bool) -> Result<Side> {
