@@ -26,9 +26,13 @@ pub fn check_memory(need: f64, bound: f64, what: &str, hint: &str) -> Result<()>
     if matches!(need.partial_cmp(&bound), Some(Ordering::Less | Ordering::Equal)) {
         return Ok(());
     }
+    let need = if need.is_finite() {
+        format!("an estimated {:.3e} MB", need / (1u64 << 20) as f64)
+    } else {
+        "unbounded memory".into()
+    };
     Err(Error::input(format!(
-        "{what} needs an estimated {} MB, more than the bound of {:.0} MB (--max-memory): {hint} or raise --max-memory",
-        if need.is_finite() { format!("{:.3e}", need / (1u64 << 20) as f64) } else { "unbounded".into() },
+        "{what} needs {need}, more than the bound of {:.0} MB (--max-memory): {hint} or raise --max-memory",
         bound / (1u64 << 20) as f64
     )))
 }
@@ -40,7 +44,7 @@ mod tests {
     #[test]
     fn needs_past_the_bound_or_not_numbers_are_refused() {
         assert!(check_memory(1e6, bytes_of(1), "a", "b").is_ok());
-        let e = check_memory(2e9, bytes_of(DEFAULT_MEMORY_MB), "a run (--step)", "coarsen --step").unwrap_err();
+        let e = check_memory(3e9, bytes_of(DEFAULT_MEMORY_MB), "a run (--step)", "coarsen --step").unwrap_err();
         assert!(e.to_string().contains("--max-memory") && e.to_string().contains("--step"), "{e}");
         assert!(check_memory(f64::NAN, 1e9, "a", "b").is_err());
         assert!(check_memory(f64::INFINITY, 1e9, "a", "b").is_err());
