@@ -295,3 +295,26 @@ fn axes_equal_to_round_off_merge() {
     assert_eq!(rows("roundoff.csv"), 2, "a start row and one arc");
     assert_eq!(rows("tilted.csv"), 201, "every row its own axis");
 }
+
+/// Issue 20: every numeric option at extreme values, seeded (scripts/fuzz-options.py runs them
+/// all): no panic, exit 0/1/2, one error line, under 20 s and 4 GiB.
+#[test]
+fn extreme_option_values_end_in_time_with_one_line() {
+    let w = Work::new();
+    let points: String =
+        (0..200).map(|k| format!("{},{:.6}\n", k as f64 * 0.5, (k as f64 * 0.05).sin() * 10.0)).collect();
+    w.write("points.csv", format!("x,y\n{points}"));
+    let options = [
+        "--tol",
+        "--min-radius",
+        "--max-radius",
+        "--max-sweep",
+        "--tangent",
+        "--corner",
+        "--curvature-threshold",
+        "--e-rate-tol",
+        "--axis-tol",
+        "--decimals",
+    ];
+    w.fuzz_options(BIN, "points.csv", &[], &options, 20, 12);
+}

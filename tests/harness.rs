@@ -129,4 +129,63 @@ impl Work {
     }
 }
 
+impl Work {
+    /// Issue 20's promise for every numeric option: runs filter `name` on `input` (in this
+    /// directory) with `base` arguments and one of `options` set to an extreme value (0,
+    /// negative, NaN, ±inf, 1e-300, 1e300, tiny, huge), `count` pairs picked by a generator
+    /// seeded with `seed`, each under a 4 GiB address-space limit; asserts for each: no panic,
+    /// exit 0, 1 or 2, one error line on a failure (warnings aside), done within 20 s.
+    pub fn fuzz_options(&self, name: &str, input: &str, base: &[&str], options: &[&str], seed: u64, count: usize) {
+        const VALUES: [&str; 9] = ["0", "-1", "NaN", "inf", "-inf", "1e-300", "1e300", "1e-9", "1e9"];
+        let mut state = seed;
+        let mut next = |n: usize| {
+            state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            (state >> 33) as usize % n
+        };
+        for _ in 0..count {
+            let (opt, value) = (options[next(options.len())], VALUES[next(VALUES.len())]);
+            let mut args: Vec<String> = vec![input.into()];
+            let mut rest = base.iter();
+            while let Some(a) = rest.next() {
+                if *a == opt {
+                    rest.next();
+                } else {
+                    args.push(a.to_string());
+                }
+            }
+            args.push(format!("{opt}={value}"));
+            let started = std::time::Instant::now();
+            let mut child = Command::new("sh")
+                .arg("-c")
+                .arg("ulimit -v 4194304; exec \"$0\" \"$@\"")
+                .arg(bin(name))
+                .args(&args)
+                .current_dir(self.dir.path())
+                .env_remove("RUST_BACKTRACE")
+                .stdin(Stdio::null())
+                .stdout(Stdio::null())
+                .stderr(Stdio::piped())
+                .spawn()
+                .expect("spawn filter");
+            let status = loop {
+                if let Some(s) = child.try_wait().expect("wait") {
+                    break s;
+                }
+                if started.elapsed().as_secs_f64() > 20.0 {
+                    let _ = child.kill();
+                    panic!("{name} {args:?}: still running after 20 s");
+                }
+                std::thread::sleep(std::time::Duration::from_millis(5));
+            };
+            let mut stderr = String::new();
+            std::io::Read::read_to_string(&mut child.stderr.take().expect("stderr"), &mut stderr).expect("stderr");
+            let code = status.code().unwrap_or(-1);
+            assert!((0..=2).contains(&code), "{name} {args:?}: status {status}: {stderr}");
+            assert!(!stderr.contains("internal error") && !stderr.contains("panicked"), "{name} {args:?}: {stderr}");
+            let errors = stderr.lines().filter(|l| !l.trim().is_empty() && !l.contains("warning:")).count();
+            assert!(code == 0 || errors == 1, "{name} {args:?}: status {code}, {errors} error lines: {stderr}");
+        }
+    }
+}
+
 pub mod paths;

@@ -976,3 +976,68 @@ fn what_no_tool_of_radius_r_reaches_is_named_apart_from_what_is_left_uncut() {
     assert!((uncut + unreachable - 103.115).abs() < 1e-3, "{r}");
     assert!(uncut > 0.0, "{r}");
 }
+
+/// Issue 20: the plan's memory is estimated from the pocket and the spacings before planning,
+/// and a plan past `--max-memory` is refused at once naming the options and the estimate
+/// (`--sample 1e-6` aborted on a 5.6 GB allocation, `--radius 1e-6` and `--step 1e-6` ran for
+/// hours, `--layers 100000` aborted on 4 GB).
+#[test]
+fn plans_past_the_memory_bound_are_refused_up_front() {
+    let w = Work::new();
+    let src = data("medial-trochoid/square.csv");
+    let src = src.to_str().unwrap();
+    let started = std::time::Instant::now();
+    let cases: [(&[&str], &str); 6] = [
+        (&["--radius", "5", "--sample", "1e-6"], "--sample 0.000001 mm"),
+        (&["--radius", "1e-6", "--sample", "2"], "--step 2.3395555688102198e-7 mm"),
+        (&["--radius", "5", "--sample", "2", "--step", "1e-6"], "--step 0.000001 mm"),
+        (&["--radius", "5", "--sample", "2", "--layers", "100000"], "100000 layers"),
+        (&["--radius", "5", "--pitch", "1e-300"], "--pitch 1e-300 mm"),
+        (&["--radius", "5", "--max-memory", "0"], "more than the bound of 0 MB"),
+    ];
+    for (args, needle) in cases {
+        let mut a = vec![src];
+        a.extend(args);
+        a.extend(["-o", "out.csv"]);
+        w.run(BIN, &a, b"").fails(2, needle);
+        assert!(!w.exists("out.csv"));
+    }
+    // Arcs go to the Voronoi input as chords of --sagitta.
+    let circle = data("medial-trochoid/circle15.csv");
+    w.run(BIN, &[circle.to_str().unwrap(), "--radius", "5", "--sagitta", "1e-300"], b"")
+        .fails(2, "--sagitta 1e-300 mm");
+    // Chords finer than the snap grid: refused (a run at 1e-9 on the square did not end).
+    w.run(BIN, &[src, "--radius", "5", "--sagitta", "1e-9"], b"")
+        .fails(2, "--sagitta 1e-9 mm is below the Voronoi snap grid");
+    assert!(started.elapsed().as_secs_f64() < 10.0, "refused at once: {:?}", started.elapsed());
+}
+
+/// Issue 20: every numeric option at extreme values, seeded (scripts/fuzz-options.py runs them
+/// all): no panic, exit 0/1/2, one error line, under 20 s and 4 GiB.
+#[test]
+fn extreme_option_values_end_in_time_with_one_line() {
+    let w = Work::new();
+    let src = data("medial-trochoid/square.csv");
+    let options = [
+        "--radius",
+        "--step",
+        "--threshold",
+        "--trochoid-radius",
+        "--pitch",
+        "--allowance",
+        "--corner-radius",
+        "--sample",
+        "--layers",
+        "--layer-depth",
+        "--resolution",
+        "--sagitta",
+        "--spindle",
+        "--teeth",
+        "--chip",
+        "--fz-max",
+        "--force-at",
+        "--decimals",
+        "--max-memory",
+    ];
+    w.fuzz_options(BIN, src.to_str().unwrap(), &["--radius", "5", "--sample", "2"], &options, 20, 12);
+}

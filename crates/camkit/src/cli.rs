@@ -97,7 +97,7 @@ pub fn within(v: f64, lo: f64, hi: f64, what: &str, unit: &str) -> Result<f64> {
 }
 
 /// A number as a message shows it: plain, or in exponent form when very large or small.
-fn short(v: f64) -> String {
+pub fn short(v: f64) -> String {
     if v != 0.0 && !(1e-6..1e9).contains(&v.abs()) { format!("{v:e}") } else { v.to_string() }
 }
 

@@ -6,6 +6,7 @@
 //! ([`tol`]), whole-or-nothing output and the common command-line pieces ([`io`], [`cli`],
 //! [`report`]), and SVG plots ([`svg`]). Nothing here is specific to one filter.
 
+pub mod budget;
 pub mod cli;
 pub mod collide;
 pub mod contour;

@@ -103,7 +103,7 @@ fn after_help() -> String {
 }
 
 fn main() -> ExitCode {
-    cli::run("curve-fit-arcs", || run(Args::parse()))
+    cli::run("curve-fit-arcs", || run(cli::parse::<Args>()?))
 }
 
 fn usage(message: String) -> Error {

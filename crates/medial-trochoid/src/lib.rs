@@ -12,6 +12,7 @@
 //! leaving uncut, and naming, the material no program reaches under the threshold.
 
 pub mod angles;
+pub mod budget;
 pub mod chords;
 pub mod corner;
 pub mod engagement;

@@ -151,6 +151,10 @@ struct Args {
     /// engagement column.
     #[arg(long, value_name = "FILE")]
     analyse: Option<PathBuf>,
+    /// Largest memory a plan may hold (MB), estimated from the pocket, --step, --sample,
+    /// --pitch, --sagitta and the layers before planning; larger plans are refused (exit 2).
+    #[arg(long, default_value_t = camkit::budget::DEFAULT_MEMORY_MB, value_name = "MB")]
+    max_memory: u64,
 }
 
 fn after_help() -> String {
@@ -182,7 +186,7 @@ fn after_help() -> String {
 }
 
 fn main() -> ExitCode {
-    cli::run("medial-trochoid", || run(Args::parse()))
+    cli::run("medial-trochoid", || run(cli::parse::<Args>()?))
 }
 
 /// The first layer's bottom, the number of layers and their depth: from the stock top down to
@@ -245,6 +249,15 @@ fn run(args: Args) -> Result<()> {
     if !(args.layer_depth.is_finite() && args.layer_depth >= 0.0) || args.layers == Some(0) {
         return Err(Error::input("--layers must be at least 1 and --layer-depth zero or more"));
     }
+    // Chords finer than the snap grid are lost in the snapping, and there would be unboundedly
+    // many of them (a run at --sagitta 1e-9 on a 60 × 40 square did not end).
+    if args.sagitta < args.resolution {
+        return Err(Error::input(format!(
+            "--sagitta {} mm is below the Voronoi snap grid (--resolution {} mm): chords that fine are lost in the snapping",
+            cli::short(args.sagitta),
+            cli::short(args.resolution)
+        )));
+    }
     let settings = Settings {
         radius: r,
         step,
@@ -305,6 +318,20 @@ fn run(args: Args) -> Result<()> {
             chorded.len()
         ));
     }
+    let (z0, layer_count, layer_depth) = layering(job.as_ref(), sources[0].z, args.layers, args.layer_depth)?;
+    camkit::budget::check_memory(
+        medial_trochoid::budget::memory(&regions, &settings, layer_count),
+        camkit::budget::bytes_of(args.max_memory),
+        &format!(
+            "the plan (--step {} mm, --sample {} mm, {layer_count} layers, --trochoid-radius {} mm{}, --sagitta {} mm)",
+            cli::short(step),
+            cli::short(settings.sample),
+            cli::short(rt),
+            args.pitch.map(|p| format!(", --pitch {} mm", cli::short(p))).unwrap_or_default(),
+            cli::short(args.sagitta)
+        ),
+        "coarsen --step, --sample, --pitch or --sagitta, use fewer layers",
+    )?;
     let leave_uncut = !(args.no_leave_uncut || args.allow_over_threshold);
     // Planned that much farther from the walls that the written program, rounded to
     // --decimals, still keeps R + allowance; checked below on the rounded rows.
@@ -326,7 +353,6 @@ fn run(args: Args) -> Result<()> {
         _ => Error::input(e.to_string()).at(Location::file(&name)),
     })?;
     let chosen = if args.program == Which::Trochoid { &plan.trochoidal } else { &plan.offset_only };
-    let (z0, layer_count, layer_depth) = layering(job.as_ref(), sources[0].z, args.layers, args.layer_depth)?;
     let out_table = to_table(chosen, z0, layer_count, layer_depth);
     // The program as written (rounded to --decimals) read back and simulated again: the
     // report's figures of the written program are this check's, as --analyse gives them.

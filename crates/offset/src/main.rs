@@ -111,6 +111,10 @@ struct Args {
     /// Write an SVG of the input and the offset.
     #[arg(long, value_name = "FILE")]
     svg: Option<PathBuf>,
+    /// Largest memory a run may hold (MB), estimated from the input and --step, --repeat or
+    /// --chord-tol before offsetting; larger runs are refused (exit 2).
+    #[arg(long, default_value_t = camkit::budget::DEFAULT_MEMORY_MB, value_name = "MB")]
+    max_memory: u64,
 }
 
 fn after_help() -> String {
@@ -145,7 +149,7 @@ fn after_help() -> String {
 }
 
 fn main() -> ExitCode {
-    cli::run("offset", || run(Args::parse()))
+    cli::run("offset", || run(cli::parse::<Args>()?))
 }
 
 fn side(args: &Args, needed: bool) -> Result<Side> {
@@ -227,6 +231,12 @@ fn run(args: Args) -> Result<()> {
             direction,
             offset: opts,
         };
+        camkit::budget::check_memory(
+            offset::budget::pocket(&table, &p),
+            camkit::budget::bytes_of(args.max_memory),
+            &format!("the pocket at --step {} mm", cli::short(step)),
+            "coarsen --step, ask fewer passes (--repeat)",
+        )?;
         offset::pocket_mode(&table, &name, &p)?
     } else if let Some(tool) = args.profile {
         let tool = if tool == ToolArg::Ball { Tool::Ball } else { Tool::Square };
@@ -241,6 +251,12 @@ fn run(args: Args) -> Result<()> {
             chord_tol: positive(args.chord_tol, "--chord-tol")?,
             offset: opts,
         };
+        camkit::budget::check_memory(
+            offset::budget::space(table.rows.len(), &o),
+            camkit::budget::bytes_of(args.max_memory),
+            &format!("the 3D offset at --chord-tol {} mm", cli::short(o.chord_tol)),
+            "raise --chord-tol",
+        )?;
         offset::space_mode(&table, &name, &o, args.window.is_none())?
     } else {
         offset::contour_mode(&table, &name, r, side(&args, true)?, &opts)?
