@@ -65,6 +65,10 @@ pub fn is_zero_length(x: f64) -> bool {
     x.abs() <= LENGTH_EPS
 }
 
+/// Largest coordinate (mm) a table may hold: beyond it a double's spacing (1.2e-7 mm at 1e9) nears
+/// the micrometre tolerances the filters promise.
+pub const COORD_LIMIT: f64 = 1e9;
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -81,7 +85,3 @@ mod tests {
         assert!(!is_zero_length(1e-11));
     }
 }
-
-/// Largest coordinate (mm) a table may hold: beyond it a double's spacing (1.2e-7 mm at 1e9) nears
-/// the micrometre tolerances the filters promise.
-pub const COORD_LIMIT: f64 = 1e9;
