@@ -50,7 +50,8 @@ fn outputs_get_the_usual_mode_and_links_are_followed() {
 #[test]
 fn an_interrupt_leaves_no_partial_output() {
     let w = Work::new();
-    let args = ["raster", "--x", "0,1000", "--y", "0,1000", "--step", "1", "--z", "10", "-o"];
+    let args =
+        ["raster", "--x", "0,1000", "--y", "0,1000", "--step", "1", "--z", "10", "--max-points", "2000000", "-o"];
     let whole = {
         let o = w.run("surf-probe-fit", &[&args[..], &["whole.csv"]].concat(), b"");
         o.ok();
