@@ -128,7 +128,8 @@ pub struct Grid {
 impl Grid {
     /// Nodes covering [x0, x1] × [y0, y1] at `step` (both ends included when they fall on it).
     pub fn covering(x0: f64, x1: f64, y0: f64, y1: f64, step: f64) -> Grid {
-        let n = |len: f64| ((len / step) * (1.0 + 1e-12)).floor() as usize + 1;
+        // Saturating: a patch too large to hold is counted, not wrapped, and the budget refuses it.
+        let n = |len: f64| (((len / step) * (1.0 + 1e-12)).floor() as usize).saturating_add(1);
         Grid { x0, y0, step, nx: n(x1 - x0), ny: n(y1 - y0) }
     }
 
