@@ -19,11 +19,16 @@ pub fn bytes_of(mb: u64) -> f64 {
     mb as f64 * (1u64 << 20) as f64
 }
 
+/// A need within its bound; an estimate that is not a number (from infinite inputs) is not.
+pub fn fits(need: f64, bound: f64) -> bool {
+    matches!(need.partial_cmp(&bound), Some(Ordering::Less | Ordering::Equal))
+}
+
 /// Refuses an estimated `need` (bytes) beyond `bound` (bytes): `what` names the run and the
 /// options that drive it, `hint` what to change. An estimate that is not a number (from
 /// infinite inputs) is refused too.
 pub fn check_memory(need: f64, bound: f64, what: &str, hint: &str) -> Result<()> {
-    if matches!(need.partial_cmp(&bound), Some(Ordering::Less | Ordering::Equal)) {
+    if fits(need, bound) {
         return Ok(());
     }
     let need = if need.is_finite() {

@@ -6,7 +6,6 @@
 
 use crate::patch::{Conditions, Grid, periods};
 use camkit::error::{Error, Result};
-use std::cmp::Ordering;
 
 /// Default work bound (edge evaluations): about a quarter of an hour on two cores.
 pub const DEFAULT_WORK: f64 = 1e9;
@@ -47,14 +46,14 @@ impl Need {
 
     /// Refuses a need beyond the budget; `what` names the run and the inputs that drive it.
     pub fn check(&self, budget: &Budget, what: &str) -> Result<()> {
-        if !fits(self.memory, budget.memory) {
+        if !camkit::budget::fits(self.memory, budget.memory) {
             return Err(Error::input(format!(
                 "{what} needs an estimated {:.0} MB, more than the bound of {:.0} MB (--max-memory): coarsen --step, shrink the area or raise --max-memory",
                 self.memory / 1e6,
                 budget.memory / 1e6
             )));
         }
-        if !fits(self.work, budget.work) {
+        if !camkit::budget::fits(self.work, budget.work) {
             return Err(Error::input(format!(
                 "{what} needs an estimated {:.3e} edge evaluations, more than the bound of {:.3e} (--max-work): coarsen --step, shrink the area or raise --max-work",
                 self.work, budget.work
@@ -62,11 +61,6 @@ impl Need {
         }
         Ok(())
     }
-}
-
-/// A need within its bound; an estimate that is not a number (from infinite inputs) is not.
-fn fits(need: f64, bound: f64) -> bool {
-    matches!(need.partial_cmp(&bound), Some(Ordering::Less | Ordering::Equal))
 }
 
 /// Checks a tool radius against [`MAX_RADIUS`] (`what` names the option or file).

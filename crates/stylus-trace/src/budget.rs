@@ -10,7 +10,6 @@ use crate::Region;
 use crate::curve::{Steps, Stylus};
 use camkit::error::{Error, Result};
 use camkit::model::Aabb;
-use std::cmp::Ordering;
 
 /// Default bound of `--max-points`: about two minutes on two cores on analytic surfaces (a drop
 /// on a sphere took 0.7 µs, 1.6e7 of them 6.8 s, at r = 1e-4 mm), up to ten on meshes (4.4 µs a
@@ -50,14 +49,14 @@ pub struct Need {
 impl Need {
     /// Refuses a need beyond the budget; `what` names the run and the options that drive it.
     pub fn check(&self, budget: &Budget, what: &str) -> Result<()> {
-        if !fits(self.memory, budget.memory) {
+        if !camkit::budget::fits(self.memory, budget.memory) {
             return Err(Error::input(format!(
                 "{what} needs an estimated {:.0} MB, more than the bound of {:.0} MB (--max-memory): coarsen the steps, give a smaller --region or raise --max-memory",
                 self.memory / 1e6,
                 budget.memory / 1e6
             )));
         }
-        if !fits(self.points, budget.points) {
+        if !camkit::budget::fits(self.points, budget.points) {
             return Err(Error::input(format!(
                 "{what} needs an estimated {:.3e} CL points and drops, more than the bound of {:.3e} (--max-points): coarsen the steps, give a smaller --region or raise --max-points",
                 self.points, budget.points
@@ -65,11 +64,6 @@ impl Need {
         }
         Ok(())
     }
-}
-
-/// A need within its bound; an estimate that is not a number (from infinite inputs) is not.
-fn fits(need: f64, bound: f64) -> bool {
-    matches!(need.partial_cmp(&bound), Some(Ordering::Less | Ordering::Equal))
 }
 
 /// The part of `region` the stylus can touch: the region and the model's box grown by r, in XY
@@ -98,7 +92,7 @@ pub fn largest_coordinate(contact_tol: f64) -> f64 {
 /// `what` names where they come from.
 pub fn check_round_off(values: &[f64], contact_tol: f64, what: &str) -> Result<()> {
     let limit = largest_coordinate(contact_tol);
-    match values.iter().map(|v| v.abs()).find(|v| !fits(*v, limit)) {
+    match values.iter().map(|v| v.abs()).find(|v| !camkit::budget::fits(*v, limit)) {
         Some(v) => Err(Error::input(format!(
             "{what} reaches {v:e} mm, beyond {limit:.3e} mm where the round-off of positions exceeds --contact-tol {contact_tol}: move the model towards the origin or give a --region near it"
         ))),
