@@ -130,6 +130,26 @@ impl Work {
 }
 
 impl Work {
+    /// Runs filter `name` with `args` in this directory with a terminal for its streams (under
+    /// util-linux `script`), returning what the terminal showed; `None` where `script` is absent.
+    pub fn run_on_terminal(&self, name: &str, args: &[&str]) -> Option<Outcome> {
+        Command::new("script").arg("--version").output().ok()?;
+        let line = std::iter::once(bin(name).display().to_string())
+            .chain(args.iter().map(|a| format!("'{a}'")))
+            .collect::<Vec<_>>()
+            .join(" ");
+        let out = Command::new("script")
+            .args(["-qec", &line, "/dev/null"])
+            .current_dir(self.dir.path())
+            .env_remove("RUST_BACKTRACE")
+            .stdin(Stdio::null())
+            .output()
+            .expect("run script");
+        Some(Outcome { status: out.status.code().unwrap_or(-1), stdout: out.stdout, stderr: String::new() })
+    }
+}
+
+impl Work {
     /// Issue 20's promise for every numeric option: runs filter `name` on `input` (in this
     /// directory) with `base` arguments and one of `options` set to an extreme value (0,
     /// negative, NaN, ±inf, 1e-300, 1e300, tiny, huge), `count` pairs picked by a generator

@@ -161,27 +161,62 @@ pub struct IoArgs {
     /// Write figures of the run (counts, deviations, timings) to FILE as JSON.
     #[arg(long, value_name = "FILE")]
     pub report: Option<PathBuf>,
+    /// No progress bars, even on a terminal (they never appear in a pipe or a file).
+    #[arg(short = 'q', long)]
+    pub quiet: bool,
 }
 
-/// A progress bar on stderr when stderr is a terminal; silent in pipes and tests.
+impl IoArgs {
+    /// A progress bar for `total` steps of `what` (see [`progress`]), hidden by `--quiet`.
+    pub fn progress(&self, total: u64, what: &str) -> Progress {
+        progress(self.quiet, total, what)
+    }
+}
+
+/// A progress bar on stderr for `total` steps of `what`, drawn only when stderr is a terminal
+/// and not `quiet`, so pipes, files and tests stay clean.
+pub fn progress(quiet: bool, total: u64, what: &str) -> Progress {
+    let p = Progress { bar: indicatif::ProgressBar::hidden() };
+    p.stage(total, what);
+    if !quiet && std::io::stderr().is_terminal() {
+        // Shown only once styled and named, so its first frame is whole.
+        p.bar.set_draw_target(indicatif::ProgressDrawTarget::stderr());
+        if total == 0 {
+            p.bar.enable_steady_tick(std::time::Duration::from_millis(120));
+        }
+    }
+    p
+}
+
+/// A progress bar (position, rate, ETA) or, for a stage of unknown length, a spinner with the
+/// time spent; made by [`progress`].
 pub struct Progress {
     bar: indicatif::ProgressBar,
 }
 
 impl Progress {
-    /// A bar for `total` steps of `what`.
-    pub fn new(total: u64, what: &str) -> Progress {
-        let bar = if std::io::stderr().is_terminal() {
-            let bar = indicatif::ProgressBar::new(total);
-            let style = indicatif::ProgressStyle::with_template("{msg} [{bar:40}] {pos}/{len} ({eta})")
-                .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar());
-            bar.set_style(style.progress_chars("=> "));
-            bar.set_message(what.to_string());
-            bar
+    /// Starts the next stage of a run: `total` steps of `what` counted from zero, or a spinner
+    /// when `total` is 0 (the stage cannot count its steps).
+    pub fn stage(&self, total: u64, what: &str) {
+        let template = if total == 0 {
+            "{spinner} {msg} ({elapsed})"
         } else {
-            indicatif::ProgressBar::hidden()
+            "{msg} [{bar:40}] {pos}/{len} ({per_sec}, {eta} left)"
         };
-        Progress { bar }
+        let style = indicatif::ProgressStyle::with_template(template)
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar())
+            .progress_chars("=> ");
+        self.bar.set_style(style);
+        self.bar.set_length(total);
+        self.bar.set_position(0);
+        self.bar.set_message(what.to_string());
+        self.bar.reset_eta();
+        self.bar.reset_elapsed();
+        if total == 0 && !self.bar.is_hidden() {
+            self.bar.enable_steady_tick(std::time::Duration::from_millis(120));
+        } else {
+            self.bar.disable_steady_tick();
+        }
     }
 
     /// Advances by `n` steps.
@@ -191,6 +226,13 @@ impl Progress {
 
     /// Removes the bar.
     pub fn finish(&self) {
+        self.bar.finish_and_clear();
+    }
+}
+
+/// A run that ends early (an error) clears its bar too, so the message stands alone.
+impl Drop for Progress {
+    fn drop(&mut self) {
         self.bar.finish_and_clear();
     }
 }

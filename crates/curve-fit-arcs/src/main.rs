@@ -159,6 +159,7 @@ fn run(args: Args) -> Result<()> {
     let to = if args.to == Kind::Auto { from } else { args.to };
     let bytes_in = input.data.len();
     let mut out = Output::new(args.io.output.as_deref());
+    let progress = args.io.progress(0, "fitting arcs");
     let (stats, runs) = if from == Kind::Gcode {
         let source = input.take_text()?;
         if source.trim().is_empty() {
@@ -201,6 +202,7 @@ fn run(args: Args) -> Result<()> {
             fit_to_table(&t, &opts, &args, &input, &mut out)?
         }
     };
+    progress.finish();
     if !camkit::tol::within(stats.largest_deviation, opts.tol) {
         return Err(Error::check(format!(
             "largest deviation {:.6} mm exceeds --tol {} mm",

@@ -340,6 +340,7 @@ fn run(args: Args) -> Result<()> {
         threshold: planned_threshold,
         ..settings
     };
+    let progress = args.io.progress(0, "planning the passes");
     let planned = if leave_uncut { plan_leaving_uncut(&regions, &planning) } else { plan(&regions, &planning) };
     let plan = planned.map_err(|e| match e {
         medial_trochoid::PlanError::Pocket(_) => Error::check(e.to_string()),
@@ -358,8 +359,10 @@ fn run(args: Args) -> Result<()> {
     // report's figures of the written program are this check's, as --analyse gives them.
     let mut text = Vec::new();
     table::write(&mut text, &out_table, &WriteOptions { decimals: args.decimals })?;
+    progress.stage(0, "simulating the written program again");
     let written = written_check(&text, &name, &regions, &settings)
         .map_err(|e| Error::check(format!("the written program does not read back: {e}")))?;
+    progress.finish();
     let w = &written.analysed;
     let troch_main = args.program == Which::Trochoid;
     if !plan.uncleared.is_empty() {
@@ -604,7 +607,9 @@ fn analyse_given(
             Error::input("no feed move at the toolpath's lowest z: nothing to analyse").at(Location::file(&name))
         );
     }
+    let progress = args.io.progress(0, "simulating the given toolpath");
     let a = medial_trochoid::analyse(given.program.clone(), s, regions);
+    progress.finish();
     let out_table = to_table(&a, given.depth, 1, 0.0);
     let mut out = Output::new(args.io.output.as_deref());
     table::write(&mut out, &out_table, &WriteOptions { decimals: args.decimals })?;

@@ -218,6 +218,7 @@ fn run(args: Args) -> Result<()> {
     }
     let opts = OffsetOptions { self_crossing_input: args.allow_self_crossing, ..OffsetOptions::default() };
     let name = input.name.clone();
+    let progress = args.io.progress(0, "offsetting and verifying");
     let outcome: Outcome = if pocketing {
         let step = positive(args.step.unwrap_or(r), "--step")?;
         if step > 2.0 * r {
@@ -261,6 +262,7 @@ fn run(args: Args) -> Result<()> {
     } else {
         offset::contour_mode(&table, &name, r, side(&args, true)?, &opts)?
     };
+    progress.finish();
     for w in &outcome.warnings {
         cli::warn(w);
     }

@@ -317,8 +317,8 @@ impl Check<'_> {
         o
     }
 
-    /// Follows the program's blocks and measures every one.
-    pub fn run(&self, poses: &[Option<NcPose>], reading: &Reading) -> Result<Outcome, String> {
+    /// Follows the program's blocks and measures every one; `tick` once per block.
+    pub fn run(&self, poses: &[Option<NcPose>], reading: &Reading, tick: &dyn Fn()) -> Result<Outcome, String> {
         let job = self.job;
         let tool = &job.tool;
         let cutter = Cutter::of(tool);
@@ -330,6 +330,7 @@ impl Check<'_> {
         let mut o = Outcome::default();
         let mut prev: Option<&NcPose> = None;
         for pose in poses {
+            tick();
             let Some(b) = pose else {
                 prev = None;
                 continue;

@@ -225,6 +225,7 @@ fn run(args: Args) -> Result<()> {
     let solid = job.as_ref().map(solid_of).transpose()?.flatten();
     let solid_ref = solid.as_ref().map(|(s, b)| (s, b));
     let link_started = Instant::now();
+    let progress = args.io.progress(0, "linking the passes");
     let rows = match &job {
         Some(j) => {
             let linked = link::Linker::new(j, walls.as_ref(), solid_ref, &input.name)?.link(&rows)?;
@@ -244,7 +245,9 @@ fn run(args: Args) -> Result<()> {
         None => rows,
     };
     let post_started = Instant::now();
+    progress.stage(0, "writing the program");
     let posted = post(&rows, &input.name, &machine, &chain, &settings, comments)?;
+    progress.finish();
     report.set("post_seconds", post_started.elapsed().as_secs_f64());
     let passes = rows.iter().filter(|r| r.rapid).count();
     if job.is_none() && passes > 1 {
@@ -344,11 +347,11 @@ fn collide(
     let poses = readback::poses(&program, &reading);
     let check = collision::Check { job, walls, solid };
     let started = Instant::now();
-    let mut o = check.run(&poses, &reading).map_err(Error::runtime)?;
+    let progress = args.io.progress(poses.len() as u64, "checking against the stock");
+    let mut o = check.run(&poses, &reading, &|| progress.inc(1)).map_err(Error::runtime)?;
     report.set("material_check_seconds", started.elapsed().as_secs_f64());
     let started = Instant::now();
-    let progress =
-        cli::Progress::new(if solid.is_some() { poses.len() as u64 } else { 0 }, "checking against the part");
+    progress.stage(if solid.is_some() { poses.len() as u64 } else { 0 }, "checking against the part");
     let so = check.run_solid(&poses, &reading, job.resolution, &|| progress.inc(1));
     progress.finish();
     report.set("part_check_seconds", started.elapsed().as_secs_f64());

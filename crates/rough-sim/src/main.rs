@@ -1,6 +1,6 @@
 //! `rough-sim`: the surface a ball end mill leaves (paper 003), as height maps and figures.
 
-use camkit::cli::{self, IoArgs, Progress};
+use camkit::cli::{self, IoArgs};
 use camkit::doc::Tool;
 use camkit::error::{Error, Location, Result};
 use camkit::io::{Input, Output, write_atomic};
@@ -114,6 +114,9 @@ struct CondArgs {
     /// Largest work, in exact edge evaluations (about 1 µs each); larger runs are refused.
     #[arg(long, default_value_t = budget::DEFAULT_WORK, value_name = "N")]
     max_work: f64,
+    /// No progress bars, even on a terminal (they never appear in a pipe or a file).
+    #[arg(short = 'q', long)]
+    quiet: bool,
 }
 
 #[derive(Args, Debug)]
@@ -353,7 +356,7 @@ fn patch(a: PatchArgs) -> Result<()> {
     budget::patch(&cond, &grid)
         .check(&bounds, &format!("a {} × {} patch (--step, --pick, --feed-per-tooth)", grid.nx, grid.ny))?;
     let spacing = positive(a.verify_spacing, "--verify-spacing")?;
-    let progress = Progress::new(1, "simulating");
+    let progress = cli::progress(a.cond.quiet, 0, "simulating the patch");
     let map = simulate(&cond, &grid);
     progress.finish();
     let simulate_seconds = started.elapsed().as_secs_f64();
@@ -455,7 +458,7 @@ fn sweep(a: SweepArgs) -> Result<()> {
     let started = Instant::now();
     let mut rows = vec![study::HEADER.to_string()];
     let mut series = Vec::new();
-    let progress = Progress::new(cells.len() as u64, "sweeping");
+    let progress = cli::progress(a.cond.quiet, cells.len() as u64, "sweeping");
     for (ri, per_radius) in cells.chunks(a.values.len()).enumerate() {
         let r = per_radius[0].0;
         let (mut pts_max, mut pts_classic) = (Vec::new(), Vec::new());
@@ -527,7 +530,9 @@ fn flat_tip(a: FlatArgs) -> Result<()> {
             if with.cutter.validate().is_ok() { study::cell(&with, step).1.map.max_height } else { f64::NAN };
         rows.push(("max_height_plain_um", f_plain.map.max_height * 1e3));
         rows.push(("max_height_with_r0_um", with_height * 1e3));
+        let progress = cli::progress(a.cond.quiet, 0, "simulating the flat tip");
         let sim = flat::simulated_r0(&plain, step, rough_sim::STATED_ERROR, FLAT_RESOLUTION).unwrap_or(f64::NAN);
+        progress.finish();
         rows.push(("r0_simulated_mm", sim));
         rows.push(("delta_simulated_um", (cond.cutter.radius - (cond.cutter.radius.powi(2) - sim * sim).sqrt()) * 1e3));
     }
@@ -588,7 +593,9 @@ fn zmap_cmd(a: ZmapArgs) -> Result<()> {
     });
     budget::zmap(&grid, boxes, cutter.radius, moves.len())
         .check(&bounds, &format!("a {} × {} z-map of {} moves (--step, --area)", grid.nx, grid.ny, moves.len()))?;
+    let progress = a.io.progress(0, "simulating the z-map");
     let map = zmap::simulate(&cutter, &moves, &grid);
+    progress.finish();
     let seconds = started.elapsed().as_secs_f64();
     let cut: Vec<f64> = map.h.iter().copied().filter(|v| v.is_finite()).collect();
     let (lo, hi) = cut.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |a, &v| (a.0.min(v), a.1.max(v)));

@@ -1,6 +1,6 @@
 //! `stylus-trace`: copy-simulation CL data on a defined model.
 
-use camkit::cli::{self, IoArgs, Progress, positive};
+use camkit::cli::{self, IoArgs, positive};
 use camkit::error::{Error, Location, Result};
 use camkit::geom::P3;
 use camkit::io::{Input, Output, write_atomic};
@@ -312,7 +312,7 @@ fn run(args: Args) -> Result<()> {
     model.check_dropped(args.strict)?;
     let loaded = started.elapsed().as_secs_f64();
     let opts = options(&args, &model, &input)?;
-    let progress = Progress::new(opts.mode.units() as u64, opts.mode.tag());
+    let progress = args.io.progress(opts.mode.units() as u64, opts.mode.tag());
     let traced_at = Instant::now();
     let paths = stylus_trace::trace(&model, &opts, &|| progress.inc(1))
         .map_err(|f| Error::check(format!("the stylus stopped at ({}, {}, {}): {}", f.at.x, f.at.y, f.at.z, f.what)))?;

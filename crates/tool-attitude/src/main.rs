@@ -316,14 +316,19 @@ fn run_fixed(args: &Args, tool: &Tool, tool_file: &str, axis: V3, started: Insta
     let part = load_part(args, tool, length)?;
     t.schema.add(&[Col::I, Col::J, Col::K]);
     let c_gouge = part.is_some().then(|| t.add_extra_column("gouge"));
+    let progress = args.io.progress(t.rows.len() as u64, "placing tips");
     let gouges: Vec<f64> = t
         .rows
         .par_iter()
         .map(|row| {
             let tip = tool_attitude::fixed_axis_ball_tip(&row.pos, &axis, r);
-            part.as_ref().map_or(0.0, |p| p.penetration(&tool_attitude::pose::Pose { tip, axis, edge: None }))
+            let gouge =
+                part.as_ref().map_or(0.0, |p| p.penetration(&tool_attitude::pose::Pose { tip, axis, edge: None }));
+            progress.inc(1);
+            gouge
         })
         .collect();
+    progress.finish();
     let num = |v: f64| {
         let mut b = Vec::new();
         camkit::num::push_shortest(&mut b, v);
@@ -392,8 +397,16 @@ fn run(args: Args) -> Result<()> {
         cli::warn("rows without `surface`/`surface2` names of the model: their flat-type axis uses the tangent planes");
     }
     let solved_at = Instant::now();
-    let results: Vec<std::result::Result<Attitude, RowError>> =
-        cs.par_iter().map(|c| attitude(&setup, c, part.as_ref())).collect();
+    let progress = args.io.progress(cs.len() as u64, "solving attitudes");
+    let results: Vec<std::result::Result<Attitude, RowError>> = cs
+        .par_iter()
+        .map(|c| {
+            let a = attitude(&setup, c, part.as_ref());
+            progress.inc(1);
+            a
+        })
+        .collect();
+    progress.finish();
     let seconds_solve = solved_at.elapsed().as_secs_f64();
     let mut poses = Vec::with_capacity(results.len());
     for (k, r) in results.into_iter().enumerate() {
