@@ -127,13 +127,19 @@ pub fn write_atomic(path: &Path, data: &[u8]) -> Result<()> {
         _ => PathBuf::from("."),
     };
     use std::os::unix::fs::PermissionsExt;
-    let mut tmp = tempfile::Builder::new()
-        .prefix(".camkit-")
-        .suffix(".tmp")
-        .permissions(std::fs::Permissions::from_mode(0o666))
-        .tempfile_in(&dir)
-        .map_err(cannot)?;
-    *PENDING.lock().unwrap_or_else(|e| e.into_inner()) = Some(tmp.path().to_path_buf());
+    // Created under the lock: an interrupt between creating the file and naming it pending
+    // would leave it behind.
+    let mut tmp = {
+        let mut pending = PENDING.lock().unwrap_or_else(|e| e.into_inner());
+        let tmp = tempfile::Builder::new()
+            .prefix(".camkit-")
+            .suffix(".tmp")
+            .permissions(std::fs::Permissions::from_mode(0o666))
+            .tempfile_in(&dir)
+            .map_err(cannot)?;
+        *pending = Some(tmp.path().to_path_buf());
+        tmp
+    };
     let written = tmp.write_all(data).and_then(|_| tmp.flush());
     let mut pending = PENDING.lock().unwrap_or_else(|e| e.into_inner());
     *pending = None;
