@@ -70,7 +70,7 @@ $(ROUGHNESS)/raster.csv: mk/roughness.mk | $(ROUGHNESS)/
 	  for (p = 0; p < 5; p++) { x = -1 + 0.5 * p; printf "%d,line,%.3f,-6,0,1000\n%d,line,%.3f,6,0,1000\n", p, x, p, x } }' > $@
 
 $(ROUGHNESS)/raster-zmap.csv $(ROUGHNESS)/raster-zmap.svg $(ROUGHNESS)/raster-zmap.json &: $(ROUGHNESS)/raster.csv $(ROUGHNESS_TOOL) $(RELEASE)/rough-sim
-	$(RELEASE)/rough-sim zmap $< --tool $(ROUGHNESS_TOOL) --spindle 1000 --step 0.01 --area=-0.75,-0.5,0.75,0.5 \
+	$(RELEASE)/rough-sim zmap $< --tool $(ROUGHNESS_TOOL) --spindle 1000 --step 0.01 --region=-0.75,0.75,-0.5,0.5 \
 	  --svg $(ROUGHNESS)/raster-zmap.svg --report $(ROUGHNESS)/raster-zmap.json -o $(ROUGHNESS)/raster-zmap.csv
 
 # The raster as the program a 3-axis machine runs: linked through the safe height, checked.

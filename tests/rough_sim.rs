@@ -183,8 +183,8 @@ fn zmap_of_a_raster_table_matches_the_patch() {
                     "1000",
                     "--step",
                     "0.02",
-                    "--area",
-                    "-0.25,0,0.25,0.5",
+                    "--region",
+                    "-0.25,0.25,0,0.5",
                     "--report",
                     "z.json",
                 ],
@@ -343,7 +343,7 @@ fn zmap_rows_one_feed_period_apart_agree() {
     let t = tool();
     w.write("raster.csv", demo_raster());
     let args =
-        ["zmap", "raster.csv", "--tool", &t, "--spindle", "1000", "--step", "0.01", "--area=-0.75,-0.75,0.75,0.75"];
+        ["zmap", "raster.csv", "--tool", &t, "--spindle", "1000", "--step", "0.01", "--region=-0.75,0.75,-0.75,0.75"];
     let h = heights(&w.run(BIN, &args, b"").ok());
     let mut worst: f64 = 0.0;
     let mut compared = 0;
@@ -355,6 +355,24 @@ fn zmap_rows_one_feed_period_apart_agree() {
     }
     assert!(compared > 100 * 151, "{compared} nodes compared");
     assert!(worst < 1e-5, "rows 0.5 mm apart differ by {} µm", worst * 1e3);
+}
+
+/// One spelling of a rectangle (issue 21): `--region X0,X1,Y0,Y1` as in stylus-trace; the old
+/// `--area X0,Y0,X1,Y1` gives the same map with a warning naming the new spelling; a reversed
+/// range is refused naming the option.
+#[test]
+fn zmap_region_is_spelt_as_everywhere_and_the_old_area_still_reads() {
+    let w = Work::new();
+    let t = tool();
+    w.write("raster.csv", demo_raster());
+    let base = ["zmap", "raster.csv", "--tool", &t, "--spindle", "1000", "--step", "0.05"];
+    let run = |extra: &[&str]| w.run(BIN, &[&base[..], extra].concat(), b"");
+    let new = run(&["--region=-0.5,0.5,-0.25,0.75"]);
+    let old = run(&["--area=-0.5,-0.25,0.5,0.75"]);
+    assert_eq!(new.ok(), old.ok());
+    assert!(new.stderr.is_empty(), "{}", new.stderr);
+    assert!(old.stderr.contains("--region -0.5,0.5,-0.25,0.75"), "{}", old.stderr);
+    run(&["--region=0.5,-0.5,0,1"]).fails(2, "--region");
 }
 
 /// Issue 20 R1: the cross-feed figures of a feed per tooth near zero are those of the circular
@@ -511,8 +529,8 @@ fn numeric_options_never_panic_nor_overrun_their_bounds() {
         ),
         (
             "zmap",
-            &["raster.csv", "--spindle", "1000", "--step", "0.05", "--area=-0.5,-0.5,0.5,0.5"],
-            &["--spindle", "--feed", "--step", "--area", "--flutes", "--max-work", "--max-memory"],
+            &["raster.csv", "--spindle", "1000", "--step", "0.05", "--region=-0.5,0.5,-0.5,0.5"],
+            &["--spindle", "--feed", "--step", "--region", "--flutes", "--max-work", "--max-memory"],
         ),
     ];
     let mut state: u64 = 0x2026_1127_0020;
@@ -536,7 +554,7 @@ fn numeric_options_never_panic_nor_overrun_their_bounds() {
             let opt = options[next(options.len())];
             let value = match opt {
                 "--flutes" | "--max-memory" => counts[next(counts.len())].to_string(),
-                "--area" => (0..4).map(|_| reals[next(reals.len())]).collect::<Vec<_>>().join(","),
+                "--region" => (0..4).map(|_| reals[next(reals.len())]).collect::<Vec<_>>().join(","),
                 "--values" | "--radii" => format!("{},{}", reals[next(reals.len())], reals[next(reals.len())]),
                 _ => reals[next(reals.len())].to_string(),
             };

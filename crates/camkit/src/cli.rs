@@ -65,17 +65,16 @@ pub fn positive(v: f64, what: &str) -> Result<f64> {
 /// does; a usage error (an unknown option, a value its parser refuses) becomes a one-line input
 /// error naming the option (exit 2), like every other bad input.
 pub fn parse<C: clap::Parser>() -> Result<C> {
-    C::try_parse().map_err(|e| {
-        use clap::error::ErrorKind;
-        if matches!(
-            e.kind(),
-            ErrorKind::DisplayHelp | ErrorKind::DisplayVersion | ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand
-        ) {
-            e.exit();
+    C::try_parse().map_err(|e| match e.kind() {
+        clap::error::ErrorKind::DisplayHelp
+        | clap::error::ErrorKind::DisplayVersion
+        | clap::error::ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand => e.exit(),
+        _ => {
+            let text = e.render().to_string();
+            // The message runs to the first blank line (a missing option is on the next line).
+            let lines: Vec<&str> = text.lines().map(str::trim).take_while(|l| !l.is_empty()).collect();
+            Error::input(lines.join(" ").trim_start_matches("error: ").to_string())
         }
-        let text = e.render().to_string();
-        let first = text.lines().next().unwrap_or("bad arguments");
-        Error::input(first.strip_prefix("error: ").unwrap_or(first).to_string())
     })
 }
 
@@ -127,23 +126,6 @@ impl Kind {
     }
 }
 
-/// Parses the command line. A usage error (an unknown option, a value that is no number) is an
-/// input error of one line naming the option, like every other bad input, rather than clap's
-/// three lines; `--help` and `--version` print and exit as usual.
-pub fn parse_args<A: clap::Parser>() -> Result<A> {
-    A::try_parse().map_err(|e| match e.kind() {
-        clap::error::ErrorKind::DisplayHelp
-        | clap::error::ErrorKind::DisplayVersion
-        | clap::error::ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand => e.exit(),
-        _ => {
-            let text = e.render().to_string();
-            // The message runs to the first blank line (a missing option is on the next line).
-            let lines: Vec<&str> = text.lines().map(str::trim).take_while(|l| !l.is_empty()).collect();
-            Error::input(lines.join(" ").trim_start_matches("error: ").to_string())
-        }
-    })
-}
-
 /// Prints a warning on stderr (`name: warning: ...`).
 pub fn warn(message: &str) {
     eprintln!("{}: warning: {}", program(), printable(message));
@@ -186,6 +168,34 @@ pub fn progress(quiet: bool, total: u64, what: &str) -> Progress {
         }
     }
     p
+}
+
+/// A rectangle in XY (mm), spelt `X0,X1,Y0,Y1` by every filter's `--region`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Region {
+    /// Smallest x.
+    pub x0: f64,
+    /// Largest x.
+    pub x1: f64,
+    /// Smallest y.
+    pub y0: f64,
+    /// Largest y.
+    pub y1: f64,
+}
+
+/// The value parser of `--region X0,X1,Y0,Y1`: four finite numbers with X0 < X1 and Y0 < Y1
+/// (clap names the option in the error, exit 2).
+pub fn region(text: &str) -> std::result::Result<Region, String> {
+    let v: Vec<f64> = text
+        .split(',')
+        .map(finite)
+        .collect::<std::result::Result<_, _>>()
+        .map_err(|e| format!("expected X0,X1,Y0,Y1 (mm): {e}"))?;
+    match v[..] {
+        [x0, x1, y0, y1] if x0 < x1 && y0 < y1 => Ok(Region { x0, x1, y0, y1 }),
+        [_, _, _, _] => Err(format!("expected X0,X1,Y0,Y1 with X0 < X1 and Y0 < Y1, got {text:?}")),
+        _ => Err(format!("expected four numbers X0,X1,Y0,Y1 (mm), got {text:?}")),
+    }
 }
 
 /// A progress bar (position, rate, ETA) or, for a stage of unknown length, a spinner with the

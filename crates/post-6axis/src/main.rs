@@ -96,7 +96,7 @@ fn after_help() -> String {
 }
 
 fn main() -> ExitCode {
-    cli::run("post-6axis", || run(Args::parse()))
+    cli::run("post-6axis", || run(cli::parse::<Args>()?))
 }
 
 /// A number as typed for a message: plain, or in exponent form when plain would run to dozens of

@@ -225,8 +225,11 @@ struct ZmapArgs {
     /// Grid step (mm).
     #[arg(long, default_value_t = 0.01, value_name = "MM")]
     step: f64,
-    /// Area x0,y0,x1,y1 (mm); default: all the tool can reach.
-    #[arg(long, allow_hyphen_values = true, value_name = "X0,Y0,X1,Y1")]
+    /// Region in XY as X0,X1,Y0,Y1 (mm), as every filter spells it; default: all the tool can reach.
+    #[arg(long, allow_hyphen_values = true, value_name = "X0,X1,Y0,Y1", value_parser = cli::region)]
+    region: Option<cli::Region>,
+    /// The old spelling X0,Y0,X1,Y1 (corners), read with a warning: use --region.
+    #[arg(long, allow_hyphen_values = true, value_name = "X0,Y0,X1,Y1", hide = true, conflicts_with = "region")]
     area: Option<String>,
     /// Largest memory (MB: heights and moves), estimated before the run; more is refused.
     #[arg(long, default_value_t = DEFAULT_MEMORY / 1_000_000, value_name = "MB")]
@@ -243,7 +246,7 @@ struct ZmapArgs {
 const FLAT_RESOLUTION: f64 = 1e-3;
 
 fn main() -> ExitCode {
-    cli::run("rough-sim", || match Cli::parse().command {
+    cli::run("rough-sim", || match cli::parse::<Cli>()?.command {
         Command::Patch(a) => patch(a),
         Command::Sweep(a) => sweep(a),
         Command::FlatTip(a) => flat_tip(a),
@@ -573,26 +576,30 @@ fn zmap_cmd(a: ZmapArgs) -> Result<()> {
     let bounds = budget_of(a.max_memory, a.max_work)?;
     let max_moves = (bounds.memory / budget::MOVE_BYTES) as usize;
     let moves = zmap::moves(&t, &input.name, &cutter, spindle, a.feed, max_moves)?;
-    let (x0, y0, x1, y1) = if let Some(text) = &a.area {
+    let (x0, y0, x1, y1) = if let Some(r) = a.region {
+        (r.x0, r.y0, r.x1, r.y1)
+    } else if let Some(text) = &a.area {
         let v: Vec<f64> = text.split(',').filter_map(|t| camkit::num::parse_finite(t.trim()).ok()).collect();
-        if v.len() != 4 {
-            return Err(Error::input(format!("--area must be four numbers x0,y0,x1,y1, got {text:?}")));
+        match v[..] {
+            [x0, y0, x1, y1] if x1 > x0 && y1 > y0 => {
+                cli::warn(&format!("--area X0,Y0,X1,Y1 is the old spelling: this is --region {x0},{x1},{y0},{y1}"));
+                (x0, y0, x1, y1)
+            }
+            _ => {
+                return Err(Error::input(format!("--area must be X0,Y0,X1,Y1 with X1 > X0 and Y1 > Y0, got {text:?}")));
+            }
         }
-        (v[0], v[1], v[2], v[3])
     } else {
         zmap::extent(&moves, &cutter)
             .ok_or_else(|| Error::input("no feed move to simulate").at(Location::file(&input.name)))?
     };
-    if !(x1 > x0 && y1 > y0) {
-        return Err(Error::input("--area must be x0,y0,x1,y1 with x1 > x0 and y1 > y0"));
-    }
     let grid = Grid::covering(x0, x1, y0, y1, a.step);
     let boxes = moves.iter().map(|m| {
         let (p, q) = (m.c0, m.centre(m.span));
         (p.x.min(q.x), p.y.min(q.y), p.x.max(q.x), p.y.max(q.y))
     });
     budget::zmap(&grid, boxes, cutter.radius, moves.len())
-        .check(&bounds, &format!("a {} × {} z-map of {} moves (--step, --area)", grid.nx, grid.ny, moves.len()))?;
+        .check(&bounds, &format!("a {} × {} z-map of {} moves (--step, --region)", grid.nx, grid.ny, moves.len()))?;
     let progress = a.io.progress(0, "simulating the z-map");
     let map = zmap::simulate(&cutter, &moves, &grid);
     progress.finish();

@@ -51,8 +51,8 @@ struct Args {
     #[arg(short = 'r', long, value_name = "MM")]
     radius: f64,
     /// Region in XY as X0,X1,Y0,Y1 (mm); default: the model's bounding box.
-    #[arg(long, value_name = "X0,X1,Y0,Y1", allow_hyphen_values = true)]
-    region: Option<String>,
+    #[arg(long, value_name = "X0,X1,Y0,Y1", allow_hyphen_values = true, value_parser = cli::region)]
+    region: Option<cli::Region>,
     /// Scan direction, degrees from +x towards +y.
     #[arg(long, default_value_t = 0.0, value_name = "DEG")]
     angle: f64,
@@ -129,7 +129,7 @@ fn after_help() -> String {
 }
 
 fn main() -> std::process::ExitCode {
-    cli::run("stylus-trace", || run(cli::parse_args::<Args>()?))
+    cli::run("stylus-trace", || run(cli::parse::<Args>()?))
 }
 
 fn usage(message: impl Into<String>) -> Error {
@@ -150,13 +150,9 @@ fn numbers(text: &str, what: &str, n: Option<usize>) -> Result<Vec<f64>> {
 }
 
 fn region(args: &Args, model: &Model, contact_tol: f64) -> Result<Region> {
-    if let Some(text) = &args.region {
-        let v = numbers(text, "--region", Some(4))?;
-        if !(v[0] < v[1] && v[2] < v[3]) {
-            return Err(usage("--region must be X0,X1,Y0,Y1 with X0 < X1 and Y0 < Y1"));
-        }
-        budget::check_round_off(&v, contact_tol, "--region")?;
-        return Ok(Region { x0: v[0], x1: v[1], y0: v[2], y1: v[3] });
+    if let Some(r) = args.region {
+        budget::check_round_off(&[r.x0, r.x1, r.y0, r.y1], contact_tol, "--region")?;
+        return Ok(Region { x0: r.x0, x1: r.x1, y0: r.y0, y1: r.y1 });
     }
     let b = model.bounds();
     if !b.is_bounded() {

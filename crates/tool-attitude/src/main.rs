@@ -109,7 +109,7 @@ fn after_help() -> String {
 }
 
 fn main() -> ExitCode {
-    cli::run("tool-attitude", || run(Args::parse()))
+    cli::run("tool-attitude", || run(cli::parse::<Args>()?))
 }
 
 /// The stable tilt range of paper 000 for the cylindrical tool, and paper 003's studied tilts.
