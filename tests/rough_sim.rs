@@ -573,3 +573,26 @@ fn numeric_options_never_panic_nor_overrun_their_bounds() {
         );
     }
 }
+
+/// Issue 20, found by scripts/fuzz-parsers.py: a raster whose one row reads y = 12345.678 (a
+/// 12 km move) was estimated at 4.2e6 units (nodes only) and then ran 15 s of CPU; the estimate
+/// now counts the flute passes over every node (1.5e7 units, ≈ 1 µs each), so `--max-work 1e7`
+/// refuses it at once, naming the option and the estimate.
+#[test]
+fn zmap_work_counts_the_flute_passes_over_each_node() {
+    let w = Work::new();
+    let t = tool();
+    let mut cl = String::from("path,move,x,y,z,i,j,k,f\n");
+    for k in 0..40 {
+        let y = if k == 23 { 12345.678 } else { (k % 5) as f64 * 0.3 };
+        cl.push_str(&format!(
+            "1,{},{},{y},{},0,0,1,600\n",
+            if k == 0 { "rapid" } else { "line" },
+            k as f64 * 0.5,
+            15.0 + (k % 3) as f64 * 0.1
+        ));
+    }
+    w.write("long.csv", cl);
+    let args = ["zmap", "long.csv", "--tool", &t, "--spindle", "8000", "--step", "0.2", "--max-work", "1e7"];
+    w.run(BIN, &args, b"").fails(2, "--max-work");
+}

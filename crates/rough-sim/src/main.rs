@@ -594,11 +594,7 @@ fn zmap_cmd(a: ZmapArgs) -> Result<()> {
             .ok_or_else(|| Error::input("no feed move to simulate").at(Location::file(&input.name)))?
     };
     let grid = Grid::covering(x0, x1, y0, y1, a.step);
-    let boxes = moves.iter().map(|m| {
-        let (p, q) = (m.c0, m.centre(m.span));
-        (p.x.min(q.x), p.y.min(q.y), p.x.max(q.x), p.y.max(q.y))
-    });
-    budget::zmap(&grid, boxes, cutter.radius, moves.len())
+    budget::zmap(&grid, &moves, &cutter)
         .check(&bounds, &format!("a {} × {} z-map of {} moves (--step, --region)", grid.nx, grid.ny, moves.len()))?;
     let progress = a.io.progress(0, "simulating the z-map");
     let map = zmap::simulate(&cutter, &moves, &grid);
