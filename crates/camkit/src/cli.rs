@@ -170,29 +170,16 @@ pub fn progress(quiet: bool, total: u64, what: &str) -> Progress {
     p
 }
 
-/// A rectangle in XY (mm), spelt `X0,X1,Y0,Y1` by every filter's `--region`.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Region {
-    /// Smallest x.
-    pub x0: f64,
-    /// Largest x.
-    pub x1: f64,
-    /// Smallest y.
-    pub y0: f64,
-    /// Largest y.
-    pub y1: f64,
-}
-
 /// The value parser of `--region X0,X1,Y0,Y1`: four finite numbers with X0 < X1 and Y0 < Y1
 /// (clap names the option in the error, exit 2).
-pub fn region(text: &str) -> std::result::Result<Region, String> {
+pub fn region(text: &str) -> std::result::Result<crate::geom::Region, String> {
     let v: Vec<f64> = text
         .split(',')
         .map(finite)
         .collect::<std::result::Result<_, _>>()
         .map_err(|e| format!("expected X0,X1,Y0,Y1 (mm): {e}"))?;
     match v[..] {
-        [x0, x1, y0, y1] if x0 < x1 && y0 < y1 => Ok(Region { x0, x1, y0, y1 }),
+        [x0, x1, y0, y1] if x0 < x1 && y0 < y1 => Ok(crate::geom::Region { x0, x1, y0, y1 }),
         [_, _, _, _] => Err(format!("expected X0,X1,Y0,Y1 with X0 < X1 and Y0 < Y1, got {text:?}")),
         _ => Err(format!("expected four numbers X0,X1,Y0,Y1 (mm), got {text:?}")),
     }

@@ -227,7 +227,7 @@ struct ZmapArgs {
     step: f64,
     /// Region in XY as X0,X1,Y0,Y1 (mm), as every filter spells it; default: all the tool can reach.
     #[arg(long, allow_hyphen_values = true, value_name = "X0,X1,Y0,Y1", value_parser = cli::region)]
-    region: Option<cli::Region>,
+    region: Option<camkit::geom::Region>,
     /// The old spelling X0,Y0,X1,Y1 (corners), read with a warning: use --region.
     #[arg(long, allow_hyphen_values = true, value_name = "X0,Y0,X1,Y1", hide = true, conflicts_with = "region")]
     area: Option<String>,

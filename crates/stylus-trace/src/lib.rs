@@ -20,29 +20,10 @@ pub mod scan;
 pub mod two_surface;
 
 use camkit::geom::P3;
+pub use camkit::geom::Region;
 use camkit::model::Model;
 use curve::{ClPoint, Steps, Stylus};
 use rayon::prelude::*;
-
-/// A rectangle in XY.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Region {
-    /// Smallest x.
-    pub x0: f64,
-    /// Largest x.
-    pub x1: f64,
-    /// Smallest y.
-    pub y0: f64,
-    /// Largest y.
-    pub y1: f64,
-}
-
-impl Region {
-    /// True if `p`'s XY lies within the rectangle grown by `margin`.
-    pub fn contains_within(&self, p: &P3, margin: f64) -> bool {
-        p.x >= self.x0 - margin && p.x <= self.x1 + margin && p.y >= self.y0 - margin && p.y <= self.y1 + margin
-    }
-}
 
 /// The stylus could not go on: where, and why.
 #[derive(Clone, Debug, PartialEq)]

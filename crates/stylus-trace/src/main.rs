@@ -52,7 +52,7 @@ struct Args {
     radius: f64,
     /// Region in XY as X0,X1,Y0,Y1 (mm); default: the model's bounding box.
     #[arg(long, value_name = "X0,X1,Y0,Y1", allow_hyphen_values = true, value_parser = cli::region)]
-    region: Option<cli::Region>,
+    region: Option<Region>,
     /// Scan direction, degrees from +x towards +y.
     #[arg(long, default_value_t = 0.0, value_name = "DEG")]
     angle: f64,
@@ -152,7 +152,7 @@ fn numbers(text: &str, what: &str, n: Option<usize>) -> Result<Vec<f64>> {
 fn region(args: &Args, model: &Model, contact_tol: f64) -> Result<Region> {
     if let Some(r) = args.region {
         budget::check_round_off(&[r.x0, r.x1, r.y0, r.y1], contact_tol, "--region")?;
-        return Ok(Region { x0: r.x0, x1: r.x1, y0: r.y0, y1: r.y1 });
+        return Ok(r);
     }
     let b = model.bounds();
     if !b.is_bounded() {

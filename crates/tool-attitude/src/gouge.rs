@@ -49,6 +49,14 @@ impl Part {
         let at = Placement { tip: pose.tip, axis: pose.axis, edge: pose.edge };
         (stand_off - self.solid.clearance(&self.body, &at, stand_off)).max(0.0)
     }
+
+    /// Whether the body at `pose` cuts in deeper than `tol` (mm): `penetration(pose) > tol`,
+    /// decided at the first overlap that deep rather than after measuring every one.
+    pub fn gouges(&self, pose: &Pose, tol: f64) -> bool {
+        let at = Placement { tip: pose.tip, axis: pose.axis, edge: pose.edge };
+        // penetration > tol ⇔ clearance < −tol (a clearance of −0 reads as no penetration).
+        self.solid.clearance_below(&self.body, &at, 0.0, -tol) < -tol
+    }
 }
 
 /// Outcome of the tilt search.
@@ -60,13 +68,15 @@ pub struct Adjusted {
     pub gouge: f64,
 }
 
-/// The tilt nearest `start` inside `[lo, hi]` at which `gouge(tilt)` ≤ `tol`: candidates every
-/// `step` outwards from `start` on both sides, the first clear one refined by bisection towards
-/// `start` to `angle_tol`. Keeps `start` when no candidate clears.
-pub fn adjust(start: f64, lo: f64, hi: f64, tol: f64, gouge: impl Fn(f64) -> f64) -> Adjusted {
-    let g0 = gouge(start);
-    if g0 <= tol {
-        return Adjusted { tilt: start, gouge: g0 };
+/// The tilt nearest `start` inside `[lo, hi]` that is clear (`over(tilt)` false: the gouge no
+/// deeper than the tolerance): candidates every `step` outwards from `start` on both sides, the
+/// first clear one refined by bisection towards `start` to `angle_tol`. Keeps `start` when no
+/// candidate clears. The search asks only the yes/no `over` and measures `gouge` (mm) at the tilt
+/// it returns.
+pub fn adjust(start: f64, lo: f64, hi: f64, gouge: impl Fn(f64) -> f64, over: impl Fn(f64) -> bool) -> Adjusted {
+    let clear = |t: f64| !over(t);
+    if clear(start) {
+        return Adjusted { tilt: start, gouge: gouge(start) };
     }
     let step = ADJUST_STEP;
     let mut k = 1;
@@ -74,20 +84,18 @@ pub fn adjust(start: f64, lo: f64, hi: f64, tol: f64, gouge: impl Fn(f64) -> f64
         let d = step * k as f64;
         let candidates = [start - d, start + d];
         if candidates.iter().all(|&c| c < lo - step || c > hi + step) {
-            return Adjusted { tilt: start, gouge: g0 };
+            return Adjusted { tilt: start, gouge: gouge(start) };
         }
         for c in candidates {
             let c = c.clamp(lo, hi);
-            let g = gouge(c);
-            if g <= tol {
+            if clear(c) {
                 // Bisect between the clear candidate and the gouging one a step nearer start.
-                let (mut bad, mut good, mut gg) = (c + (start - c).signum() * step.min((start - c).abs()), c, g);
+                let (mut bad, mut good) = (c + (start - c).signum() * step.min((start - c).abs()), c);
                 while (good - bad).abs() > ADJUST_ANGLE_TOL {
                     let mid = 0.5 * (good + bad);
-                    let gm = gouge(mid);
-                    if gm <= tol { (good, gg) = (mid, gm) } else { bad = mid }
+                    if clear(mid) { good = mid } else { bad = mid }
                 }
-                return Adjusted { tilt: good, gouge: gg };
+                return Adjusted { tilt: good, gouge: gouge(good) };
             }
         }
         k += 1;
@@ -297,10 +305,11 @@ mod tests {
     #[test]
     fn adjust_finds_the_nearest_clear_tilt() {
         // Gouge whenever tilt > −0.3: the clear tilt nearest −0.1 is −0.3.
-        let a = adjust(-0.1, -0.35, 0.0, 1e-9, |t| (t + 0.3).max(0.0));
+        let g = |t: f64| (t + 0.3).max(0.0);
+        let a = adjust(-0.1, -0.35, 0.0, g, |t| g(t) > 1e-9);
         assert!((a.tilt + 0.3).abs() <= ADJUST_ANGLE_TOL && a.gouge <= 1e-9, "{a:?}");
         // Nothing clear inside the range: the start is kept and reported.
-        let a = adjust(-0.1, -0.2, 0.0, 1e-9, |t| (t + 0.3).max(0.0));
+        let a = adjust(-0.1, -0.2, 0.0, g, |t| g(t) > 1e-9);
         assert_eq!(a.tilt, -0.1);
         assert!(a.gouge > 0.0);
     }

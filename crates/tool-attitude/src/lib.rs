@@ -205,6 +205,13 @@ pub fn attitude(setup: &Setup, c: &Contact, part: Option<&Part>) -> Result<Attit
 /// clear, see [`gouge::adjust`]).
 fn tilt_search(setup: &Setup, part: Option<&Part>, make: &dyn Fn(f64) -> Pose) -> (f64, Option<f64>, bool) {
     let Some(p) = part else { return (setup.tilt, None, false) };
-    let a = gouge::adjust(setup.tilt, setup.range.0, setup.range.1, setup.gouge_tol, |t| p.penetration(&make(t)));
+    let tol = setup.gouge_tol;
+    let a = gouge::adjust(
+        setup.tilt,
+        setup.range.0,
+        setup.range.1,
+        |t| p.penetration(&make(t)),
+        |t| p.gouges(&make(t), tol),
+    );
     (a.tilt, Some(a.gouge), a.tilt != setup.tilt)
 }

@@ -93,6 +93,26 @@ impl Plane {
     }
 }
 
+/// A rectangle in XY (mm), spelt `X0,X1,Y0,Y1` on every command line ([`crate::cli::region`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Region {
+    /// Smallest x.
+    pub x0: f64,
+    /// Largest x.
+    pub x1: f64,
+    /// Smallest y.
+    pub y0: f64,
+    /// Largest y.
+    pub y1: f64,
+}
+
+impl Region {
+    /// True if `p`'s XY lies within the rectangle grown by `margin`.
+    pub fn contains_within(&self, p: &P3, margin: f64) -> bool {
+        p.x >= self.x0 - margin && p.x <= self.x1 + margin && p.y >= self.y0 - margin && p.y <= self.y1 + margin
+    }
+}
+
 /// Cross product z-component of two plane vectors (positive when `b` is counter-clockwise of `a`).
 pub fn cross2(a: &V2, b: &V2) -> f64 {
     a.x * b.y - a.y * b.x
