@@ -54,8 +54,26 @@ pub struct ContourArgs {
     pub curve_tol: f64,
     /// Drawings: read only this layer (a DXF layer; an SVG Inkscape layer's label or a group's
     /// id); repeat for several. Default: every layer.
-    #[arg(long = "layer", value_name = "NAME")]
-    pub layers: Vec<String>,
+    #[arg(long = "layer", id = "drawing_layers", value_name = "NAME")]
+    pub drawing_layers: Vec<String>,
+}
+
+/// The input kinds as every contour filter's `--help` tells them.
+pub fn help_text() -> String {
+    [
+        "Contour inputs (by extension, or --from for standard input):",
+        "  *.csv, other   the toolpath table: each path one contour (line/cw/ccw rows with xc,yc)",
+        "  *.dxf          ASCII DXF: LINE, ARC, CIRCLE, LWPOLYLINE and POLYLINE (bulges), ELLIPSE, SPLINE",
+        "                 (control points) on the --layer(s) asked for, chained end to end (gaps up to",
+        "                 1e-4 mm; an open chain is refused naming the gap), in mm, z from the entities",
+        "  *.svg          path, rect, circle, ellipse, polygon, polyline, line with their transforms; mm from",
+        "                 the root's width/height (96 dpi user units without), y up from the viewBox's",
+        "                 bottom-left corner; --layer picks Inkscape layers (label) or groups (id)",
+        "  Lines stay lines and circular arcs arcs; Béziers, ellipses and splines become lines and arcs",
+        "  within --curve-tol (default 0.001 mm), proven both ways. A drawing's contours are numbered",
+        "  by path in the order they appear. Another kind of file given as a table is named as such.",
+    ]
+    .join("\n")
 }
 
 /// How a contour input is read.
@@ -85,7 +103,11 @@ impl ContourArgs {
                 crate::cli::program()
             )));
         }
-        Ok(Options { from: self.from, drawing: crate::dxf::Options { tol, layers: self.layers.clone() }, gcode })
+        Ok(Options {
+            from: self.from,
+            drawing: crate::dxf::Options { tol, layers: self.drawing_layers.clone() },
+            gcode,
+        })
     }
 }
 
@@ -113,7 +135,8 @@ pub fn contours(input: &Input, opts: &Options) -> Result<Loaded> {
 /// a `line`, `cw` or `ccw` row per piece; every row on its contour's first line in the drawing),
 /// so that a filter made for tables takes drawings too. G-code is the caller's to read.
 pub fn table(input: &Input, opts: &Options) -> Result<(table::Table, Vec<(String, u64)>)> {
-    let read = match opts.from.resolve(input) {
+    let kind = opts.from.resolve(input);
+    let read = match kind {
         InputKind::Dxf => crate::dxf::read(&input.name, &String::from_utf8_lossy(&input.data), &opts.drawing)?,
         InputKind::Svg => super::svg_in::read(&input.name, input.text()?, &opts.drawing)?,
         InputKind::Gcode if !opts.gcode => {
@@ -135,7 +158,13 @@ pub fn table(input: &Input, opts: &Options) -> Result<(table::Table, Vec<(String
         } else {
             format!(" on the layers {} (the drawing's: {})", opts.drawing.layers.join(", "), read.layers.join(", "))
         };
-        return Err(Error::input(format!("no closed contour in the drawing{on}")).at(Location::file(&input.name)));
+        let has = if kind == InputKind::Svg {
+            "a path, rect, circle, ellipse, polygon, polyline or line element"
+        } else {
+            "a LINE, ARC, CIRCLE, LWPOLYLINE, POLYLINE, ELLIPSE or SPLINE entity"
+        };
+        return Err(Error::input(format!("no closed contour in the drawing{on}: it needs {has}"))
+            .at(Location::file(&input.name)));
     }
     Ok((drawing_table(&read.sources), read.skipped))
 }
