@@ -151,7 +151,7 @@ pub fn nurbs_beziers(degree: usize, knots: &[f64], points: &[P2], weights: &[f64
     if knots.len() != n + p + 1 {
         return Err(format!("{n} control points of degree {p} need {} knots, got {}", n + p + 1, knots.len()));
     }
-    if weights.len() != n || weights.iter().any(|w| !(*w > 0.0)) {
+    if weights.len() != n || weights.iter().any(|w| w.is_nan() || *w <= 0.0) {
         return Err(format!("needs {n} positive weights, got {:?}", weights));
     }
     if knots.windows(2).any(|w| w[1] < w[0]) || knots[p] >= knots[n] {
