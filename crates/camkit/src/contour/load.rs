@@ -49,7 +49,7 @@ pub struct ContourArgs {
     #[arg(long, value_enum, default_value_t = InputKind::Auto)]
     pub from: InputKind,
     /// Drawings: largest distance (mm) between a curve (an SVG Bézier or elliptical arc, a DXF
-    /// ELLIPSE or SPLINE) and the lines and arcs it is read as, proven both ways.
+    /// ELLIPSE or SPLINE) and the lines and arcs it is read as, proven both ways (1e-6 to 10).
     #[arg(long, alias = "dxf-tol", default_value_t = crate::tol::CURVE_TOL, value_name = "MM")]
     pub curve_tol: f64,
     /// Drawings: read only this layer (a DXF layer; an SVG Inkscape layer's label or a group's
@@ -96,7 +96,8 @@ impl Default for Options {
 impl ContourArgs {
     /// The options, checked; `gcode` says whether the filter reads G-code.
     pub fn options(&self, gcode: bool) -> Result<Options> {
-        let tol = crate::cli::positive(self.curve_tol, "--curve-tol")?;
+        // Finer than a nanometre, the proof's halvings would multiply past any use.
+        let tol = crate::cli::within(self.curve_tol, 1e-6, 10.0, "--curve-tol", " mm")?;
         if self.from == InputKind::Gcode && !gcode {
             return Err(Error::input(format!(
                 "--from gcode: {} reads contours from the table, a DXF or an SVG drawing",
