@@ -572,6 +572,29 @@ mod tests {
         }
     }
 
+    #[test]
+    fn ellipses_splines_and_layers() {
+        // Half an ellipse (a = 10, b = 5) closed by a LINE on layer Cut; a full ratio-1 ELLIPSE
+        // (a circle, read exactly) and a fit-point SPLINE elsewhere.
+        let half = "0\nELLIPSE\n8\nCut\n10\n0\n20\n0\n11\n10\n21\n0\n40\n0.5\n41\n0\n42\n3.141592653589793\n";
+        let chord = "0\nLINE\n8\nCut\n10\n-10\n20\n0\n11\n10\n21\n0\n";
+        let round = "0\nELLIPSE\n8\nOther\n10\n40\n20\n0\n11\n0\n21\n3\n40\n1\n";
+        let text = dxf(&format!("{half}{chord}{round}"));
+        let cut = Options { tol: 1e-4, layers: vec!["Cut".into()] };
+        let r = read("e.dxf", &text, &cut).unwrap();
+        assert_eq!((r.sources.len(), r.layers.clone()), (1, vec!["Cut".to_string(), "Other".to_string()]));
+        let d = &r.sources[0].contour;
+        let exact = std::f64::consts::PI * 25.0;
+        // Within tol of the curve everywhere: the area within tol times the perimeter.
+        assert!((d.area().abs() - exact).abs() <= 1e-4 * d.length(), "{} vs {exact}", d.area());
+        assert!(r.curve_deviation > 0.0 && r.curve_deviation <= 1e-4, "{}", r.curve_deviation);
+        let all = read("e.dxf", &text, &Options::default()).unwrap();
+        assert_eq!(all.sources[1].contour, Contour::circle(P2::new(40.0, 0.0), 3.0, std::f64::consts::FRAC_PI_2, true));
+        let fit = dxf("0\nSPLINE\n71\n3\n74\n2\n11\n0\n21\n0\n11\n5\n21\n5\n");
+        let e = read("s.dxf", &fit, &Options::default()).unwrap_err().to_string();
+        assert!(e.contains("s.dxf:") && e.contains("2 fit points and no control points"), "{e}");
+    }
+
     proptest::proptest! {
         #![proptest_config(proptest::prelude::ProptestConfig::with_cases(24))]
 
