@@ -1,16 +1,34 @@
-//! Closed contours from an ASCII DXF file: LINE, ARC, CIRCLE, LWPOLYLINE (with bulges) and
-//! POLYLINE/VERTEX entities of the ENTITIES section, chained end to end within
-//! [`tol::DXF_JOIN`] into closed contours, as the same [`Source`]s the toolpath table gives
-//! (`contour::table::pocket_regions` then nests them into outer boundaries and islands).
+//! Closed contours from an ASCII DXF file: LINE, ARC, CIRCLE, LWPOLYLINE and old-style
+//! POLYLINE/VERTEX (with bulges), ELLIPSE and SPLINE (NURBS, as lines and arcs within
+//! [`Options::tol`] by [`crate::contour::curve`]) entities of the ENTITIES section, on the layers
+//! asked for, chained end to end within [`tol::DXF_JOIN`] into closed contours, as the same
+//! [`Source`]s the toolpath table gives (`contour::table::pocket_regions` then nests them into
+//! outer boundaries and islands).
 //! Coordinates are taken as millimetres in the XY plane (extrusion +Z); errors name the DXF line.
 //! A small reader of the group-code pairs: the format is two lines per value, and a reader of our
 //! own gives every error its line (the `dxf` crate's errors do not carry one).
 
+use crate::contour::curve::{self, Bezier, Ellipse};
 use crate::contour::table::Source;
 use crate::contour::{Contour, Seg, Vertex};
 use crate::error::{Error, Location, Result};
 use crate::geom::P2;
 use crate::tol;
+
+/// How a drawing is read.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Options {
+    /// Largest distance (mm) between an ELLIPSE or SPLINE and the lines and arcs made of it.
+    pub tol: f64,
+    /// Layers to read (all when empty).
+    pub layers: Vec<String>,
+}
+
+impl Default for Options {
+    fn default() -> Options {
+        Options { tol: tol::CURVE_TOL, layers: Vec::new() }
+    }
+}
 
 /// Contours read from a DXF file and what was left out.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -21,6 +39,10 @@ pub struct Read {
     pub skipped: Vec<(String, u64)>,
     /// Largest gap closed when chaining pieces (mm).
     pub largest_gap: f64,
+    /// Largest proven distance (mm) between a curve (ELLIPSE, SPLINE) and its lines and arcs.
+    pub curve_deviation: f64,
+    /// The layers of the drawing's contour entities, in order of appearance.
+    pub layers: Vec<String>,
 }
 
 /// One group: code, value and the line of the code.
@@ -32,10 +54,13 @@ struct Group<'a> {
 
 /// A piece of a contour to be chained, with its z and source line.
 #[derive(Clone, Copy)]
-struct Piece {
-    seg: Seg,
-    z: f64,
-    line: u64,
+pub(crate) struct Piece {
+    /// The line or arc.
+    pub(crate) seg: Seg,
+    /// Its height.
+    pub(crate) z: f64,
+    /// The source line of its entity or element.
+    pub(crate) line: u64,
 }
 
 fn groups<'a>(name: &str, text: &'a str) -> Result<Vec<Group<'a>>> {
@@ -94,11 +119,11 @@ fn entities<'a, 'g>(gs: &'g [Group<'a>]) -> Vec<(&'a str, u64, &'g [Group<'a>])>
 }
 
 /// Reads the closed contours of the DXF text `text` (file `name`).
-pub fn read(name: &str, text: &str) -> Result<Read> {
+pub fn read(name: &str, text: &str, opts: &Options) -> Result<Read> {
     let gs = groups(name, text)?;
     let ents = entities(&gs);
     let mut out = Read::default();
-    let mut closed: Vec<(Contour, f64, u64, u64)> = Vec::new();
+    let mut closed: Vec<Closed> = Vec::new();
     let mut pieces: Vec<Piece> = Vec::new();
     let mut k = 0;
     while k < ents.len() {
@@ -114,7 +139,22 @@ pub fn read(name: &str, text: &str) -> Result<Read> {
                 }
             }
         };
-        if matches!(kind, "LINE" | "ARC" | "CIRCLE" | "LWPOLYLINE" | "POLYLINE") {
+        let contour_kind = matches!(kind, "LINE" | "ARC" | "CIRCLE" | "LWPOLYLINE" | "POLYLINE" | "ELLIPSE" | "SPLINE");
+        if contour_kind {
+            let layer = at(8).map_or("0", |g| g.value);
+            if !out.layers.iter().any(|l| l == layer) {
+                out.layers.push(layer.to_string());
+            }
+            if !opts.layers.is_empty() && !opts.layers.iter().any(|l| l == layer) {
+                if kind == "POLYLINE" {
+                    while k < ents.len() && matches!(ents[k].0, "VERTEX" | "SEQEND") {
+                        k += 1;
+                    }
+                }
+                continue;
+            }
+        }
+        if contour_kind {
             let ez = num(230, Some(1.0))?;
             if ez < 1.0 - tol::UNIT_VECTOR_SLACK {
                 return Err(Error::input(format!(
@@ -215,11 +255,54 @@ pub fn read(name: &str, text: &str) -> Result<Read> {
                 }
                 polyline(&mut closed, &mut pieces, verts, flags & 1 == 1, z, line);
             }
+            "ELLIPSE" => {
+                let c = P2::new(num(10, None)?, num(20, None)?);
+                let z = num(30, Some(0.0))?;
+                let u = crate::geom::V2::new(num(11, None)?, num(21, None)?);
+                let ratio = num(40, None)?;
+                if u.norm() <= tol::POINT_EPS || !(ratio > 0.0 && ratio <= 1.0 + tol::UNIT_VECTOR_SLACK) {
+                    return Err(Error::input(format!(
+                        "ELLIPSE needs a major axis (11, 21) and a ratio (40) in (0, 1], got {} and {ratio}",
+                        u.norm()
+                    ))
+                    .at(Location::file(name).line(line)));
+                }
+                let e = Ellipse { c, u, v: crate::geom::V2::new(-u.y, u.x) * ratio };
+                let (t0, t1) = (num(41, Some(0.0))?, num(42, Some(std::f64::consts::TAU))?);
+                let mut sweep = (t1 - t0).rem_euclid(std::f64::consts::TAU);
+                if sweep <= tol::ANGLE_EPS {
+                    sweep = std::f64::consts::TAU;
+                }
+                let segs = match e.arc(t0, t0 + sweep) {
+                    Ok(Seg::Arc(a)) if sweep >= std::f64::consts::TAU - tol::ANGLE_EPS => {
+                        closed.push((Contour::circle(c, a.r, a.start, true), z, line, line));
+                        continue;
+                    }
+                    Ok(seg) => vec![seg],
+                    Err(beziers) => curve_segs(name, line, &beziers, opts.tol, &mut out.curve_deviation)?,
+                };
+                curve(&mut closed, &mut pieces, segs, z, line);
+            }
+            "SPLINE" => {
+                let beziers = spline(name, line, body)?;
+                let segs = curve_segs(name, line, &beziers, opts.tol, &mut out.curve_deviation)?;
+                curve(&mut closed, &mut pieces, segs, num(30, Some(0.0))?, line);
+            }
             "SEQEND" | "VERTEX" => {}
             other => out.skipped.push((other.to_string(), line)),
         }
     }
-    let chained = chain(name, &pieces, &mut out.largest_gap)?;
+    finish(name, closed, &pieces, &mut out)?;
+    Ok(out)
+}
+
+/// A closed contour read from a drawing: the contour, its z, its first and last source lines.
+pub(crate) type Closed = (Contour, f64, u64, u64);
+
+/// The drawing's contours: the closed ones and the open `pieces` chained, in the order of their
+/// first line, numbered from 1 as `path`.
+pub(crate) fn finish(name: &str, mut closed: Vec<Closed>, pieces: &[Piece], out: &mut Read) -> Result<()> {
+    let chained = chain(name, pieces, &mut out.largest_gap)?;
     closed.extend(chained);
     closed.sort_by_key(|c| c.2);
     out.sources = closed
@@ -227,13 +310,75 @@ pub fn read(name: &str, text: &str) -> Result<Read> {
         .enumerate()
         .map(|(i, (contour, z, line, last_line))| Source { contour, path: i as i64 + 1, z, row: 0, line, last_line })
         .collect();
-    Ok(out)
+    Ok(())
+}
+
+/// The lines and arcs of a curve's Bézier pieces within `tol`, the error naming the entity.
+fn curve_segs(name: &str, line: u64, beziers: &[Bezier], tol: f64, worst: &mut f64) -> Result<Vec<Seg>> {
+    let mut segs = Vec::new();
+    for b in beziers {
+        segs.extend(curve::biarcs(b, tol, worst).map_err(|u| {
+            Error::input(format!(
+                "the curve cannot be approximated by arcs within {tol} mm near ({:.6}, {:.6}) (a cusp?)",
+                u.at.x, u.at.y
+            ))
+            .at(Location::file(name).line(line))
+        })?);
+    }
+    Ok(segs)
+}
+
+/// A curve's pieces as a closed contour (when it ends where it starts) or as pieces to chain.
+fn curve(closed: &mut Vec<Closed>, pieces: &mut Vec<Piece>, segs: Vec<Seg>, z: f64, line: u64) {
+    let (Some(first), Some(last)) = (segs.first(), segs.last()) else { return };
+    if (last.end() - first.start()).norm() <= tol::DXF_JOIN {
+        closed.push((Contour::from_segs(&segs, true), z, line, line));
+    } else {
+        pieces.extend(segs.into_iter().map(|seg| Piece { seg, z, line }));
+    }
+}
+
+/// A SPLINE entity's NURBS as rational Bézier pieces.
+fn spline(name: &str, line: u64, body: &[Group]) -> Result<Vec<Bezier>> {
+    let here = |g: &Group| Location::file(name).line(g.line);
+    let whole = || Location::file(name).line(line);
+    let (mut degree, mut knots, mut weights, mut points, mut fit) = (None, Vec::new(), Vec::new(), Vec::new(), 0);
+    let mut x = None;
+    for g in body {
+        match g.code {
+            71 => degree = Some(number(name, g)? as usize),
+            40 => knots.push(number(name, g)?),
+            41 => weights.push(number(name, g)?),
+            10 => x = Some(number(name, g)?),
+            20 => {
+                let Some(px) = x.take() else {
+                    return Err(Error::input("SPLINE: a y (20) without its x (10)").at(here(g)));
+                };
+                points.push(P2::new(px, number(name, g)?));
+            }
+            11 => fit += 1,
+            _ => {}
+        }
+    }
+    if points.is_empty() {
+        let what = if fit > 0 { format!("{fit} fit points and no control points") } else { "no control points".into() };
+        return Err(Error::input(format!(
+            "SPLINE with {what}: save the drawing with control points (every CAD program's DXF export does)"
+        ))
+        .at(whole()));
+    }
+    let degree = degree.ok_or_else(|| Error::input("SPLINE needs its degree (71)").at(whole()))?;
+    if weights.is_empty() {
+        weights = vec![1.0; points.len()];
+    }
+    curve::nurbs_beziers(degree, &knots, &points, &weights)
+        .map_err(|e| Error::input(format!("SPLINE: {e}")).at(whole()))
 }
 
 /// A polyline's vertices as a closed contour (flagged closed, or ending where it starts) or as
 /// pieces to chain.
-fn polyline(
-    closed: &mut Vec<(Contour, f64, u64, u64)>,
+pub(crate) fn polyline(
+    closed: &mut Vec<Closed>,
     pieces: &mut Vec<Piece>,
     mut verts: Vec<Vertex>,
     flag: bool,
@@ -267,7 +412,7 @@ fn polyline(
 
 /// Open pieces joined end to end (a piece may be reversed) into closed contours; a chain that
 /// does not close, or a point where three or more pieces meet, is an error naming a line.
-fn chain(name: &str, pieces: &[Piece], largest_gap: &mut f64) -> Result<Vec<(Contour, f64, u64, u64)>> {
+fn chain(name: &str, pieces: &[Piece], largest_gap: &mut f64) -> Result<Vec<Closed>> {
     let cell = tol::DXF_JOIN.max(tol::POINT_EPS) * 4.0;
     let key = |p: &P2| ((p.x / cell).floor() as i64, (p.y / cell).floor() as i64);
     let mut grid: std::collections::HashMap<(i64, i64), Vec<(usize, bool)>> = std::collections::HashMap::new();
@@ -310,7 +455,7 @@ fn chain(name: &str, pieces: &[Piece], largest_gap: &mut f64) -> Result<Vec<(Con
                     .map(|l| l.to_string())
                     .collect();
                 return Err(Error::input(format!(
-                    "{} entity ends meet at ({:.6}, {:.6}) (entities at lines {}): a contour's pieces join two by two",
+                    "{} piece ends meet at ({:.6}, {:.6}) (from lines {}): a contour's pieces join two by two",
                     cands.len() + 1,
                     end.x,
                     end.y,
@@ -319,14 +464,7 @@ fn chain(name: &str, pieces: &[Piece], largest_gap: &mut f64) -> Result<Vec<(Con
                 .at(Location::file(name).line(pieces[last].line)));
             }
             let Some(&(next, at_end, gap)) = cands.first() else {
-                return Err(Error::input(format!(
-                    "open contour: the chain from line {} ends at ({:.6}, {:.6}) with no entity within {} mm",
-                    pieces[first].line,
-                    end.x,
-                    end.y,
-                    tol::DXF_JOIN
-                ))
-                .at(Location::file(name).line(pieces[last].line)));
+                return Err(open_chain(name, pieces, &used, first, last, &segs));
             };
             *largest_gap = largest_gap.max(gap);
             if next == first {
@@ -334,7 +472,7 @@ fn chain(name: &str, pieces: &[Piece], largest_gap: &mut f64) -> Result<Vec<(Con
             }
             if used[next] {
                 return Err(Error::input(format!(
-                    "entity at line {} is reached twice while chaining",
+                    "the piece from line {} is reached twice while chaining",
                     pieces[next].line
                 ))
                 .at(Location::file(name).line(pieces[next].line)));
@@ -355,6 +493,33 @@ fn chain(name: &str, pieces: &[Piece], largest_gap: &mut f64) -> Result<Vec<(Con
         out.push((Contour { vertices, closed: true }, pieces[first].z, pieces[first].line, last_line));
     }
     Ok(out)
+}
+
+/// The error for a chain that does not close: where it ends, and the nearest end it could have
+/// met (its own start, or a free end of another entity) with the gap's size.
+fn open_chain(name: &str, pieces: &[Piece], used: &[bool], first: usize, last: usize, segs: &[Seg]) -> Error {
+    let end = segs[segs.len() - 1].end();
+    let mut nearest = (segs[0].start(), (segs[0].start() - end).norm(), "its own start".to_string());
+    for pc in pieces.iter().zip(used).filter(|(_, u)| !**u).map(|(pc, _)| pc) {
+        for q in [pc.seg.start(), pc.seg.end()] {
+            let d = (q - end).norm();
+            if d < nearest.1 {
+                nearest = (q, d, format!("an end of the piece from line {}", pc.line));
+            }
+        }
+    }
+    let (q, gap, what) = nearest;
+    Error::input(format!(
+        "open contour: the chain of pieces from line {} ends at ({:.6}, {:.6}); the nearest end, {what} at ({:.6}, {:.6}), is {} mm away (ends join within {} mm)",
+        pieces[first].line,
+        end.x,
+        end.y,
+        q.x,
+        q.y,
+        crate::cli::short(gap),
+        tol::DXF_JOIN
+    ))
+    .at(Location::file(name).line(pieces[last].line))
 }
 
 #[cfg(test)]
@@ -378,7 +543,7 @@ mod tests {
         e += &line((0.0, 10.0), (20.0, 10.0));
         e += "0\nARC\n10\n0\n20\n5\n30\n0\n40\n5\n50\n90\n51\n270\n";
         e += "0\nCIRCLE\n10\n10\n20\n5\n30\n0\n40\n2\n0\nTEXT\n1\nhello\n";
-        let r = read("t.dxf", &dxf(&e)).unwrap();
+        let r = read("t.dxf", &dxf(&e), &Options::default()).unwrap();
         assert_eq!(r.sources.len(), 2);
         assert_eq!(r.skipped.len(), 1);
         let slot = &r.sources[0].contour;
@@ -399,12 +564,35 @@ mod tests {
         // POLYLINE: the same as VERTEX entities.
         let pl = "0\nPOLYLINE\n66\n1\n70\n1\n10\n0\n20\n0\n30\n0\n0\nVERTEX\n10\n30\n20\n0\n0\nVERTEX\n10\n40\n20\n0\n42\n1\n\
                   0\nVERTEX\n10\n40\n20\n10\n0\nVERTEX\n10\n30\n20\n10\n0\nSEQEND\n";
-        let r = read("p.dxf", &dxf(&format!("{lw}{pl}"))).unwrap();
+        let r = read("p.dxf", &dxf(&format!("{lw}{pl}")), &Options::default()).unwrap();
         assert_eq!(r.sources.len(), 2);
         let want = 100.0 + std::f64::consts::PI * 25.0 / 2.0;
         for s in &r.sources {
             assert!((s.contour.area().abs() - want).abs() < 1e-9, "{}", s.contour.area());
         }
+    }
+
+    #[test]
+    fn ellipses_splines_and_layers() {
+        // Half an ellipse (a = 10, b = 5) closed by a LINE on layer Cut; a full ratio-1 ELLIPSE
+        // (a circle, read exactly) and a fit-point SPLINE elsewhere.
+        let half = "0\nELLIPSE\n8\nCut\n10\n0\n20\n0\n11\n10\n21\n0\n40\n0.5\n41\n0\n42\n3.141592653589793\n";
+        let chord = "0\nLINE\n8\nCut\n10\n-10\n20\n0\n11\n10\n21\n0\n";
+        let round = "0\nELLIPSE\n8\nOther\n10\n40\n20\n0\n11\n0\n21\n3\n40\n1\n";
+        let text = dxf(&format!("{half}{chord}{round}"));
+        let cut = Options { tol: 1e-4, layers: vec!["Cut".into()] };
+        let r = read("e.dxf", &text, &cut).unwrap();
+        assert_eq!((r.sources.len(), r.layers.clone()), (1, vec!["Cut".to_string(), "Other".to_string()]));
+        let d = &r.sources[0].contour;
+        let exact = std::f64::consts::PI * 25.0;
+        // Within tol of the curve everywhere: the area within tol times the perimeter.
+        assert!((d.area().abs() - exact).abs() <= 1e-4 * d.length(), "{} vs {exact}", d.area());
+        assert!(r.curve_deviation > 0.0 && r.curve_deviation <= 1e-4, "{}", r.curve_deviation);
+        let all = read("e.dxf", &text, &Options::default()).unwrap();
+        assert_eq!(all.sources[1].contour, Contour::circle(P2::new(40.0, 0.0), 3.0, std::f64::consts::FRAC_PI_2, true));
+        let fit = dxf("0\nSPLINE\n71\n3\n74\n2\n11\n0\n21\n0\n11\n5\n21\n5\n");
+        let e = read("s.dxf", &fit, &Options::default()).unwrap_err().to_string();
+        assert!(e.contains("s.dxf:") && e.contains("2 fit points and no control points"), "{e}");
     }
 
     proptest::proptest! {
@@ -438,7 +626,7 @@ mod tests {
                 let a = (a.x + jitter * (next() - 0.5), a.y + jitter * (next() - 0.5));
                 e += &line(a, (b.x, b.y));
             }
-            let r = read("s.dxf", &dxf(&e)).unwrap();
+            let r = read("s.dxf", &dxf(&e), &Options::default()).unwrap();
             proptest::prop_assert_eq!(r.sources.len(), 1);
             let c = &r.sources[0].contour;
             proptest::prop_assert_eq!(c.vertices.len(), n);
@@ -453,17 +641,18 @@ mod tests {
     #[test]
     fn bad_files_name_their_line() {
         let open = dxf(&(line((0.0, 0.0), (10.0, 0.0)) + &line((10.0, 0.0), (10.0, 10.0))));
-        let e = read("o.dxf", &open).unwrap_err().to_string();
+        let e = read("o.dxf", &open, &Options::default()).unwrap_err().to_string();
         assert!(e.contains("o.dxf:") && e.contains("open contour"), "{e}");
+        assert!(e.contains("its own start at (0.000000, 0.000000), is 14.142135623730951 mm away"), "{e}");
         let bad = dxf("0\nLINE\n10\nten\n20\n0\n11\n1\n21\n0\n");
-        let e = read("b.dxf", &bad).unwrap_err().to_string();
+        let e = read("b.dxf", &bad, &Options::default()).unwrap_err().to_string();
         assert!(e.contains("b.dxf:14"), "{e}");
         let code = "0\nSECTION\nx\nENTITIES\n";
-        let e = read("c.dxf", code).unwrap_err().to_string();
+        let e = read("c.dxf", code, &Options::default()).unwrap_err().to_string();
         assert!(e.contains("c.dxf:3"), "{e}");
         let three =
             dxf(&(line((0.0, 0.0), (10.0, 0.0)) + &line((10.0, 0.0), (0.0, 0.0)) + &line((0.0, 0.0), (0.0, 5.0))));
-        let e = read("t.dxf", &three).unwrap_err().to_string();
+        let e = read("t.dxf", &three, &Options::default()).unwrap_err().to_string();
         assert!(e.contains("meet"), "{e}");
     }
 }

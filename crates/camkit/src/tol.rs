@@ -44,6 +44,10 @@ pub const DEGENERATE_SPREAD_REL: f64 = 1e-9;
 /// (CAD exports leave round-off gaps of this order; the later piece's start is kept).
 pub const DXF_JOIN: f64 = 1e-4;
 
+/// Default largest distance (mm) between a drawing's curve (an SVG Bézier or elliptical arc, a
+/// DXF ELLIPSE or SPLINE) and the lines and arcs it is read as (`--curve-tol`).
+pub const CURVE_TOL: f64 = 1e-3;
+
 /// `a` and `b` differ by at most `eps`.
 pub fn near(a: f64, b: f64, eps: f64) -> bool {
     (a - b).abs() <= eps

@@ -1,6 +1,7 @@
 //! `curve-fit-arcs`: point streams and G-code to lines and arcs within a proven tolerance.
 
 use camkit::cli::{self, IoArgs, Kind, positive};
+use camkit::contour::load::{ContourArgs, InputKind};
 use camkit::error::{Error, Location, Result};
 use camkit::geom::Plane;
 use camkit::io::{Input, Output, write_atomic};
@@ -37,10 +38,9 @@ blocks the filter does not model (they are written back verbatim, in order).",
 struct Args {
     #[command(flatten)]
     io: IoArgs,
-    /// Input format.
-    #[arg(long, value_enum, default_value_t = Kind::Auto)]
-    from: Kind,
-    /// Output format (auto: the input's).
+    #[command(flatten)]
+    contours: ContourArgs,
+    /// Output format (auto: the input's; the table for a drawing).
     #[arg(long, value_enum, default_value_t = Kind::Auto)]
     to: Kind,
     /// Tolerance (mm): largest distance between output and input, both ways.
@@ -98,6 +98,8 @@ fn after_help() -> String {
     s.push_str("Other columns pass through; a merged row keeps the values of the input row it ends at.\n\n");
     s.push_str("G-code: G0/G1/G2/G3 (I/J/K or R), G17/G18/G19, G20/G21, G90/G91, G90.1/G91.1, F, E (M82/M83), N,\n");
     s.push_str("( ) and ; comments, modal moves. E is summed over merged moves (relative) or carried (absolute).\n");
+    s.push_str(&camkit::contour::load::help_text());
+    s.push('\n');
     s.push_str("\nExit status: 0 done, 1 a check failed, 2 bad input or usage.");
     s
 }
@@ -154,8 +156,9 @@ fn options(args: &Args) -> Result<Options> {
 fn run(args: Args) -> Result<()> {
     let opts = options(&args)?;
     let started = Instant::now();
+    let contour_opts = args.contours.options(true)?;
     let mut input = Input::open(&args.io.input)?;
-    let from = args.from.resolve(&input);
+    let from = if contour_opts.from.resolve(&input) == InputKind::Gcode { Kind::Gcode } else { Kind::Table };
     let to = if args.to == Kind::Auto { from } else { args.to };
     let bytes_in = input.data.len();
     let mut out = Output::new(args.io.output.as_deref());
@@ -185,7 +188,14 @@ fn run(args: Args) -> Result<()> {
             fit_to_table(&t, &opts, &args, &input, &mut out)?
         }
     } else {
-        let t = table::read(&input, &[Col::X, Col::Y])?;
+        let (t, skipped) = camkit::contour::load::table(&input, &contour_opts)?;
+        if let Some((kind, line)) = skipped.first() {
+            cli::warn(&format!(
+                "{}: {} drawing entities that are not contours skipped (the first: {kind} at line {line})",
+                input.name,
+                skipped.len()
+            ));
+        }
         let distinct = t.rows.windows(2).filter(|w| (w[0].pos - w[1].pos).norm() > camkit::tol::POINT_EPS).count() + 1;
         if t.rows.is_empty() || distinct < 2 {
             let what = if t.rows.is_empty() { "no points" } else { "a single point" };

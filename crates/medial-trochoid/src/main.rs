@@ -35,7 +35,7 @@ enum Which {
     version,
     allow_negative_numbers = true,
     about = "Engagement of contour-parallel pocketing, danger regions on the medial axis, trochoidal clearing first (paper 001).",
-    long_about = "Reads closed contours (outer boundaries and islands; lines and arcs) from the toolpath table or a DXF file, makes \
+    long_about = "Reads closed contours (outer boundaries and islands; lines and arcs) from the toolpath table, a DXF or an SVG drawing, makes \
 contour-parallel pocket passes, simulates the material removal to get the exact 2D engagement angle along them, finds \
 where passes over the threshold meet the medial axis (segment Voronoi diagram without the edges at reflex vertices), \
 clears those stretches first with constant-radius trochoidal loops, re-simulates the whole program and estimates both \
@@ -45,6 +45,8 @@ programs' machining time.",
 struct Args {
     #[command(flatten)]
     io: IoArgs,
+    #[command(flatten)]
+    contours: camkit::contour::load::ContourArgs,
     /// Tool radius R (mm); default the radius of the setup's tool.
     #[arg(long, value_name = "MM", required_unless_present = "setup")]
     radius: Option<f64>,
@@ -164,10 +166,8 @@ fn after_help() -> String {
     );
     s.push_str("  engagement deg            engagement angle at the row's end (material-removal simulation)\n");
     s.push_str("Each input path is one closed contour; nesting decides outer boundaries and islands.\n");
-    s.push_str(
-        "An INPUT named *.dxf is read as ASCII DXF: LINE, ARC, CIRCLE, LWPOLYLINE and POLYLINE entities chained\n",
-    );
-    s.push_str("end to end (gaps up to 1e-4 mm) into closed contours, in mm, z from the entities.\n");
+    s.push_str(&camkit::contour::load::help_text());
+    s.push('\n');
     s.push_str(
         "Output rows are samples along the tool-centre path (at most --sample mm apart); tag is entry (helical\n",
     );
@@ -291,9 +291,10 @@ fn run(args: Args) -> Result<()> {
             },
         },
     };
+    let contour_opts = args.contours.options(false)?;
     let input = Input::open(&args.io.input)?;
     let name = input.name.clone();
-    let loaded = camkit::contour::load::contours(&input)?;
+    let loaded = camkit::contour::load::contours(&input, &contour_opts)?;
     if let Some((kind, line)) = loaded.skipped.first() {
         cli::warn(&format!(
             "{name}: {} entities that are not contours skipped (the first: {kind} at line {line})",

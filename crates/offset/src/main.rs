@@ -2,6 +2,7 @@
 
 use camkit::cli::{self, IoArgs, Kind, positive};
 use camkit::contour::OffsetOptions;
+use camkit::contour::load::{ContourArgs, InputKind};
 use camkit::contour::offset::Side;
 use camkit::contour::pocket::{Direction, PocketOptions};
 use camkit::error::{Error, Location, Result};
@@ -95,9 +96,8 @@ struct Args {
     /// they would gouge).
     #[arg(long)]
     allow_self_crossing: bool,
-    /// Input format.
-    #[arg(long, value_enum, default_value_t = Kind::Auto)]
-    from: Kind,
+    #[command(flatten)]
+    contours: ContourArgs,
     /// Output format: the table (the only one: `offset | post-6axis --setup` makes the program,
     /// with linked, collision-checked passes).
     #[arg(long, value_enum, default_value_t = Kind::Table)]
@@ -144,6 +144,8 @@ fn after_help() -> String {
     s.push_str(
         "Other columns pass through from the first row of the contour (3D mode: from the row each point comes from).\n",
     );
+    s.push_str(&camkit::contour::load::help_text());
+    s.push('\n');
     s.push_str("\nExit status: 0 done (also when an offset leaves nothing: a warning says so), 1 a check failed, 2 bad input or usage.");
     s
 }
@@ -188,16 +190,16 @@ fn run(args: Args) -> Result<()> {
     if args.repeat == Some(0) {
         return Err(Error::input("--repeat must be at least 1"));
     }
+    let contour_opts = args.contours.options(true)?;
     let input = Input::open(&args.io.input)?;
-    let from = args.from.resolve(&input);
-    let mut table = if from == Kind::Gcode {
+    let mut table = if contour_opts.from.resolve(&input) == InputKind::Gcode {
         let text = input.text()?.to_string();
         if text.trim().is_empty() {
             return Err(Error::input("empty input: no G-code").at(Location::file(&input.name)));
         }
         camkit::gcode::program_to_table(&camkit::gcode::read(&input.name, text)?).0
     } else {
-        let (table, skipped) = camkit::contour::load::table(&input)?;
+        let (table, skipped) = camkit::contour::load::table(&input, &contour_opts)?;
         if let Some((kind, line)) = skipped.first() {
             cli::warn(&format!(
                 "{}: {} entities that are not contours skipped (the first: {kind} at line {line})",

@@ -8,10 +8,12 @@
 //! nest into [`region::Region`]s (an outer boundary with islands) and [`pocket`] turns regions into
 //! contour-parallel passes in machining order.
 
+pub mod curve;
 pub mod load;
 pub mod offset;
 pub mod pocket;
 pub mod region;
+pub mod svg_in;
 pub mod table;
 mod verify;
 
