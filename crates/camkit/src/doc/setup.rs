@@ -265,7 +265,7 @@ impl Setup {
             Some(p) if path != "-" && !p.as_os_str().is_empty() => p.to_path_buf(),
             _ => PathBuf::from("."),
         };
-        setup.resolve(&input.name, &base)
+        setup.resolve(&input.name, &base).map_err(|e| crate::json::at_value(&input, e))
     }
 
     /// Reads the files the setup names (relative to `base`) and checks every number.
@@ -570,5 +570,16 @@ mod tests {
         .unwrap();
         let j = Setup::read(p.to_str().unwrap()).unwrap();
         assert_eq!(j.stock, Stock::Box { min: P3::new(-1.0, -2.0, -0.5), max: P3::new(11.0, 22.0, 5.5) });
+    }
+
+    /// A value that parses but fails a check is named at its line and column (issue 20, D14).
+    #[test]
+    fn a_bad_value_names_its_line_and_column() {
+        let text =
+            "{\"tool\": \"t.json\", \"stock\": {\"min\": [0, 0, 0]},\n \"clearance_height\": 20, \"safe_height\": 5}";
+        let e = job(text, &[TOOL]).unwrap_err();
+        assert!(e.to_string().contains("setup.json:1:29 (stock): "), "{e}");
+        let e = job(text, &[("t.json", r#"{"kind": "flat", "radius": -4}"#)]).unwrap_err();
+        assert!(e.to_string().contains("t.json:1:28 (radius): "), "{e}");
     }
 }
