@@ -224,6 +224,9 @@ pub enum Part {
 pub struct Job {
     /// The setup file, for messages.
     pub file: String,
+    /// The setup document's text (empty if not read from one), so that an error about one of its
+    /// fields found later names that field's line and column.
+    pub source: String,
     /// The tool.
     pub tool: Tool,
     /// The tool document's path, for messages.
@@ -265,7 +268,9 @@ impl Setup {
             Some(p) if path != "-" && !p.as_os_str().is_empty() => p.to_path_buf(),
             _ => PathBuf::from("."),
         };
-        setup.resolve(&input.name, &base).map_err(|e| crate::json::at_value(&input, e))
+        let mut job = setup.resolve(&input.name, &base).map_err(|e| crate::json::at_value(&input, e))?;
+        job.source = input.text()?.to_string();
+        Ok(job)
     }
 
     /// Reads the files the setup names (relative to `base`) and checks every number.
@@ -450,6 +455,7 @@ impl Setup {
         };
         Ok(Job {
             file: file.to_string(),
+            source: String::new(),
             tool,
             tool_file,
             stock,
@@ -472,7 +478,11 @@ impl Setup {
 impl Job {
     /// The error for a field of this setup.
     pub fn error(&self, field: &str, message: impl Into<String>) -> Error {
-        Error::input(message).at(Location::file(&self.file).field(field))
+        let mut at = Location::file(&self.file);
+        if let Some((line, column)) = crate::json::locate(&self.source, field) {
+            at = at.line(line).column(column);
+        }
+        Error::input(message).at(at.field(field))
     }
 }
 
