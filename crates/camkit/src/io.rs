@@ -95,11 +95,10 @@ impl Source {
             std::io::copy(&mut std::io::stdin().lock(), &mut file).map_err(cannot)?;
             return Ok(Source { name: "stdin".into(), file });
         }
-        let file = std::fs::File::open(arg).map_err(|e| Error::io(e, &format!("cannot read {arg}")))?;
-        if file.metadata().is_ok_and(|m| m.is_dir()) {
-            let e = std::io::Error::from(std::io::ErrorKind::IsADirectory);
-            return Err(Error::io(e, &format!("cannot read {arg}")));
-        }
+        let cannot = |e| Error::io(e, &format!("cannot read {arg}"));
+        let file = std::fs::File::open(arg).map_err(cannot)?;
+        // A directory opens but cannot be read: say so now, as reading it whole would.
+        (&file).read(&mut [0u8; 1]).map_err(cannot)?;
         Ok(Source { name: arg.to_string(), file })
     }
 
@@ -411,6 +410,35 @@ mod tests {
         assert_eq!(e.to_string(), bad.text().unwrap_err().to_string());
         assert!(e.to_string().contains("b.nc:2"), "{e}");
         assert_eq!(bad.data.len(), 12, "the bytes are kept for the message");
+    }
+
+    /// A streamed output is a temporary file until committed, restarts empty, and a dropped
+    /// one leaves nothing; a source reads from its start each time.
+    #[test]
+    fn streamed_output_appears_only_on_commit_and_sources_reread() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("out.nc");
+        let mut out = Stream::new(Some(&path)).unwrap();
+        out.write_all(b"G1 X1\n").unwrap();
+        out.restart().unwrap();
+        out.write_all(b"G1 X2\n").unwrap();
+        assert_eq!(out.len(), 6);
+        assert!(!path.exists());
+        out.commit().unwrap();
+        assert_eq!(std::fs::read(&path).unwrap(), b"G1 X2\n");
+        let mut dropped = Stream::new(Some(&dir.path().join("never.nc"))).unwrap();
+        dropped.write_all(b"partial").unwrap();
+        drop(dropped);
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1, "only out.nc");
+        assert!(!PENDING.lock().unwrap().iter().any(|p| p.starts_with(dir.path())), "temporaries forgotten");
+        let source = Source::open(path.to_str().unwrap()).unwrap();
+        for _ in 0..2 {
+            let mut text = String::new();
+            source.reader().unwrap().read_to_string(&mut text).unwrap();
+            assert_eq!(text, "G1 X2\n");
+        }
+        let e = Source::open(dir.path().to_str().unwrap()).unwrap_err();
+        assert!(e.to_string().ends_with("Is a directory"), "{e}");
     }
 
     #[test]
