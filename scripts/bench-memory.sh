@@ -57,6 +57,29 @@ for spec in 10:2000 50:2000 105:2000 50:50000; do
   before=-; [ -n "$BEFORE" ] && { before=$(peak "$BEFORE/curve-fit-arcs" "$f" --tol 0.01); cmp -s "$DIR/out" <("$BIN/curve-fit-arcs" "$f" --tol 0.01) || before="$before (output differs!)"; }
   echo "| curve-fit-arcs G-code → G-code, runs of $RUN moves | $(size_mb "$f") MB | $out MB | $before | $after |"
 done
+# A table of about 50 MB: the same ripple arcs as points, one path per run (not streamed yet).
+if [ ! -s "$DIR/pts-50mb.csv" ]; then
+  python3 - > "$DIR/pts-50mb.csv" <<'PY'
+import math, sys
+out, size, k = sys.stdout, 0, 0
+out.write("path,x,y\n")
+while size < 50_000_000:
+    r, cx, cy = 5 + (k * 7) % 45, (k % 50) * 100.0, (k // 50 % 50) * 100.0
+    rows = []
+    for i in range(2001):
+        t, rr = i * 0.01, r + 0.03 * math.sin(i * 1.7)
+        rows.append(f"{k},{cx + rr * math.cos(t):.3f},{cy + rr * math.sin(t):.3f}\n")
+    block = "".join(rows)
+    out.write(block)
+    size += len(block)
+    k += 1
+PY
+fi
+f=$DIR/pts-50mb.csv
+after=$(peak "$BIN/curve-fit-arcs" "$f")
+out=$(size_mb "$DIR/out")
+before=-; [ -n "$BEFORE" ] && { before=$(peak "$BEFORE/curve-fit-arcs" "$f"); cmp -s "$DIR/out" <("$BIN/curve-fit-arcs" "$f") || before="$before (output differs!)"; }
+echo "| curve-fit-arcs table → table, runs of 2000 rows (read whole) | $(size_mb "$f") MB | $out MB | $before | $after |"
 for spec in "0,670 0,670" "0,2080 0,2080"; do
   set -- $spec
   step=1
