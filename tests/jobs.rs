@@ -350,18 +350,18 @@ fn bad_jobs_are_refused_naming_the_field() {
         (
             "setup.json",
             SETUP.replace(r#""max": [100, 60, 0]"#, r#""max": [50, 60, 0]"#),
-            "setup.json (stock): the stock does not contain the toolpath: passes.csv:",
+            "setup.json:1:32 (stock): the stock does not contain the toolpath: passes.csv:",
         ),
         (
             "setup.json",
             SETUP.replace(r#""clearance_height": 25"#, r#""clearance_height": -2"#),
-            "setup.json (clearance_height): clearance_height -2 is below the stock top 0",
+            "setup.json:2:73 (clearance_height): clearance_height -2 is below the stock top 0",
         ),
         ("tool.json", TOOL.replace(r#", "number": 7"#, ""), "tool.json (number): the tool has no `number`"),
         (
             "passes.csv",
             passes().replacen("0,rapid,4,4,-6", "0,rapid,48,30,-6", 1),
-            "setup.json (part): the pass starting at passes.csv:2",
+            "setup.json:2:11 (part): the pass starting at passes.csv:2",
         ),
     ];
     for (file, text, needle) in cases {

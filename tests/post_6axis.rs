@@ -464,7 +464,7 @@ fn bad_input_is_refused_without_output() {
     // A bad machine document names the JSON path.
     w.write("m.json", r#"{"name": "x", "chain": [{"rotary": "A", "min": 10}, {"linear": true}]}"#);
     w.write("ok.csv", "x,y,z,i,j,k,f\n0,0,0,0,0,1,100\n");
-    w.run(BIN, &["ok.csv", "--machine", "m.json"], b"").fails(2, "m.json (chain[0].min)");
+    w.run(BIN, &["ok.csv", "--machine", "m.json"], b"").fails(2, "m.json:1:48 (chain[0].min)");
     w.run(BIN, &["ok.csv", "--machine", &m, "--tol", "0"], b"").fails(2, "--tol must be a positive number");
     w.run(BIN, &["ok.csv", "--machine", &m, "--tol", "0.0000001"], b"")
         .fails(2, "too small for the program's decimals");
@@ -876,7 +876,7 @@ fn numeric_options_and_mutated_documents_are_refused_or_posted() {
     setup["plunge"] = serde_json::json!({"feed": 1e-9});
     w.write("setup.json", setup.to_string());
     check(&["nf.csv", "-m", &machine("paper002-ac.json"), "--setup", "setup.json", "--feed", "500"])
-        .fails(2, "setup.json (plunge.feed): the plunge feed must be from 0.1 to 1000000, got 1e-9");
+        .fails(2, "setup.json:1:299 (plunge.feed): the plunge feed must be from 0.1 to 1000000, got 1e-9");
     eprintln!("outcomes (exit 0, 1, 2): {seen:?}");
     assert!(seen[0] > 20 && seen[2] > 100, "{seen:?}");
 }

@@ -281,7 +281,8 @@ fn bad_input_is_refused_with_one_line() {
         .fails(2, "more than the bound of 100 MB");
     w.run(BIN, &["patch", &t, "--pick", "10", "--feed-per-tooth", "0.5"], b"").fails(2, "below the tool diameter");
     w.write("zero.json", r#"{"kind": "ball", "radius": 5, "flutes": 0}"#);
-    w.run(BIN, &["patch", "zero.json", "--pick", "0.5", "--feed-per-tooth", "0.5"], b"").fails(2, "zero.json (flutes)");
+    w.run(BIN, &["patch", "zero.json", "--pick", "0.5", "--feed-per-tooth", "0.5"], b"")
+        .fails(2, "zero.json:1:41 (flutes)");
     w.write("bad.csv", "x,y,z,f\n0,0,0,100\n1,x,0,100\n");
     w.run(BIN, &["zmap", "bad.csv", "--tool", &t, "--spindle", "1000"], b"").fails(2, "bad.csv:3:2 (y)");
     w.write("nofeed.csv", "x,y,z\n0,0,0\n1,0,0\n");

@@ -777,8 +777,15 @@ fn p4_runs_past_their_bounds_are_refused_before_they_start() {
     let huge: Vec<[P3; 3]> =
         box_mesh(P3::new(-20.0, -20.0, 0.0), P3::new(20.0, 20.0, 20.0)).iter().map(|t| t.map(|p| p * 1e12)).collect();
     w.write("huge.stl", camkit::model::mesh::binary_stl(&huge));
-    let cases: [(&[&str], &str); 6] = [
+    // One vertex of one top facet moved 1e6 mm up (as in fuzz-flagged domes that ran for hours):
+    // the line over it would climb a sliver a million mm high.
+    let mut spike = box_mesh(P3::new(-20.0, -20.0, 0.0), P3::new(20.0, 20.0, 20.0));
+    let top = spike.iter().position(|t| t.iter().all(|p| p.z == 20.0)).expect("a top facet");
+    spike[top][0].z = 1e6;
+    w.write("spike.stl", camkit::model::mesh::binary_stl(&spike));
+    let cases: [(&[&str], &str); 7] = [
         (&["stray.stl", "-r", "5", "--pick", "5"], "stray.stl: the area traced within the model's bounding box"),
+        (&["spike.stl", "-r", "5", "--pick", "5"], "(--max-points)"),
         (&["huge.stl", "-r", "5", "--pick", "5"], "beyond 3.518e9 mm where the round-off"),
         (&["sphere.json", "-r", "12.5", "--pick", "1e-9", "--region", "-20,20,-20,20"], "(--max-memory)"),
         (&["sphere.json", "-r", "12.5", "--mode", "contour", "--z-step", "1e-9"], "contour mode at --z-step"),

@@ -351,11 +351,11 @@ fn bad_input_is_refused_with_its_place() {
     w.write("tool.json", r#"{"kind": "cylindrical-nonrotating"}"#);
     run(&stream(&ok, 12.5), &[]).fails(2, "missing field `radius`");
     w.write("tool.json", r#"{"kind": "flat-nonrotating", "radius": 5, "included_angle": 60}"#);
-    run(&stream(&ok, 12.5), &[]).fails(2, "tool.json (flank_length)");
+    run(&stream(&ok, 12.5), &[]).fails(2, "tool.json:1:1 (flank_length)");
     w.write("tool.json", r#"{"kind": "flat-nonrotating", "radius": 5, "included_angle": 60, "flank_length": 2}"#);
     run(&stream(&ok, 12.5), &[]).fails(2, "missing column `p2x`");
     w.write("tool.json", r#"{"kind": "bull", "radius": 5, "corner_radius": 1}"#);
-    run(&stream(&ok, 12.5), &[]).fails(2, "tool.json (kind)");
+    run(&stream(&ok, 12.5), &[]).fails(2, "tool.json:1:10 (kind)");
     assert!(!w.exists("out.csv"), "nothing written on bad input");
 }
 
@@ -418,7 +418,7 @@ fn fixed_axis_ball_tips_from_a_stylus_trace() {
     let t = Rows::parse(&tilted);
     assert!((s.tip(0) - t.tip(0) - V3::new(0.0, 1.8, 2.4)).norm() < 1e-9);
     w.run(BIN, &["cl.csv", "--tool", "flat.json", "--axis", "0,0,1"], b"")
-        .fails(2, "flat.json (kind): --axis (a fixed axis) takes a ball end mill");
+        .fails(2, "flat.json:1:10 (kind): --axis (a fixed axis) takes a ball end mill");
     w.run(BIN, &["cl.csv", "--tool", "ball.json", "--axis", "0,0,0"], b"")
         .fails(2, "--axis must be a nonzero direction");
     w.run(BIN, &["cl.csv", "--tool", "ball.json", "--axis", "0,1"], b"").fails(2, "--axis takes three numbers");

@@ -14,7 +14,13 @@ fn gcode(c: &mut Criterion) {
     for tol in [0.025, 0.005] {
         let opts = Options { tol, ..Options::default() };
         group.bench_function(format!("jsdc tol {tol}"), |b| {
-            b.iter(|| black_box(fit_source("jsdc", &source, &opts, None, false).expect("fits")))
+            b.iter(|| {
+                let mut out = Vec::with_capacity(source.len());
+                black_box(
+                    fit_source("jsdc", &mut || Ok(source.as_bytes()), &mut out, &opts, None, false).expect("fits"),
+                );
+                out
+            })
         });
     }
     group.bench_function("jsdc read only", |b| {

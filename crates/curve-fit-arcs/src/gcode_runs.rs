@@ -4,10 +4,13 @@
 use crate::fit::{Rounding, Shape};
 use crate::segment::{self, Unfittable};
 use crate::{FittedRun, Options, Stats, push_distinct};
-use camkit::gcode::{Block, Blocks, Modes, Motion, MoveBlock, OutMove, Writer};
+use camkit::error::Error;
+use camkit::gcode::{Block, Decimals, Modes, Motion, MoveBlock, OutMove, StreamBlocks, Writer};
 use camkit::geom::{P2, P3};
+use camkit::io::Restart;
 use camkit::num::round_to;
 use std::collections::VecDeque;
+use std::io::{BufRead, Write};
 
 /// How the program is written back.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -21,10 +24,10 @@ pub struct Format {
 }
 
 impl Format {
-    /// A program's own precision from the blocks read: the most decimals its coordinates and E
+    /// A program's own precision from the blocks read (their most decimals `seen`, whether any
+    /// was in inch): the most decimals its coordinates and E
     /// words use, at least 3 (4 for an inch program) for coordinates; arc centres one more.
-    pub fn of(blocks: &Blocks) -> Format {
-        let (seen, inch) = (blocks.decimals(), blocks.inch());
+    pub fn of(seen: Decimals, inch: bool) -> Format {
         let decimals = seen.xyz.max(if inch { 4 } else { 3 });
         Format { decimals, centre_decimals: decimals + 1, e_decimals: seen.e.max(1) }
     }
@@ -101,69 +104,83 @@ fn continues(head: &MoveBlock, m: &MoveBlock, opts: &Options) -> bool {
 /// Lines read to guess the output's precision before the streaming pass.
 const GUESS_LINES: usize = 2048;
 
-/// Reads and fits `source` in one streaming pass, holding one run at a time, never the whole
-/// program. The output's precision depends on the whole program (its most decimals), so it is
-/// guessed from the first lines and checked at the end; a wrong guess, or a run that failed
-/// under it, is done again with the precision read from the whole program. `decimals`
-/// overrides the coordinates'. The fitted runs are returned too when `keep_runs` (for a plot
-/// or the lower bound), otherwise their buffers are reused run to run.
-pub fn fit_source(
+/// Reads and fits a program in one streaming pass, holding one run at a time, never the whole
+/// program, and writes the result to `out` run by run. `open` gives the program's text from its
+/// start (it is read a second time when the first guess of the precision was wrong). The
+/// output's precision depends on the whole program (its most decimals), so it is guessed from
+/// the first lines and checked at the end; a wrong guess, or a run that failed under it, is done
+/// again (`out` restarted) with the precision read from the whole program. `decimals` overrides
+/// the coordinates'. The fitted runs are returned too when `keep_runs` (for a plot or the lower
+/// bound), otherwise their buffers are reused run to run.
+pub fn fit_source<R: BufRead>(
     name: &str,
-    source: &str,
+    open: &mut dyn FnMut() -> camkit::error::Result<R>,
+    out: &mut dyn Restart,
     opts: &Options,
     decimals: Option<u32>,
     keep_runs: bool,
-) -> Result<(Vec<u8>, Stats, Vec<FittedRun>), ProgramError> {
+) -> Result<(Stats, Vec<FittedRun>), ProgramError> {
+    let mut lines = StreamBlocks::new(name, open().map_err(ProgramError::Read)?);
     // The first lines are kept, not read again, and fitted first.
-    let mut lines = Blocks::new(name, source);
-    let first: Vec<Block> =
-        lines.by_ref().take(GUESS_LINES).collect::<camkit::error::Result<_>>().map_err(ProgramError::Read)?;
-    let guess = Format::of(&lines).with_decimals(decimals);
-    match fit_blocks(source, &mut first.into_iter().map(Ok).chain(lines.by_ref()), opts, guess, keep_runs) {
-        Ok(fitted) if Format::of(&lines).with_decimals(decimals) == guess => return Ok(fitted),
+    let mut first = VecDeque::with_capacity(GUESS_LINES);
+    for b in lines.by_ref().take(GUESS_LINES) {
+        first.push_back(b.map_err(ProgramError::Read)?);
+    }
+    let guess = Format::of(lines.decimals(), lines.inch()).with_decimals(decimals);
+    match fit_blocks(&mut lines, first, out, opts, guess, keep_runs) {
+        Ok(fitted) if Format::of(lines.decimals(), lines.inch()).with_decimals(decimals) == guess => {
+            return Ok(fitted);
+        }
         Err(ProgramError::Read(e)) => return Err(ProgramError::Read(e)),
         Ok(_) | Err(ProgramError::Fit(_)) => {}
     }
-    let mut all = Blocks::new(name, source);
-    for b in all.by_ref() {
+    // Read to its end for the whole program's precision (a failed run stopped the first pass).
+    while let Some(b) = lines.next() {
         b.map_err(ProgramError::Read)?;
+        lines.release(usize::MAX);
     }
-    let format = Format::of(&all).with_decimals(decimals);
-    fit_blocks(source, &mut Blocks::new(name, source), opts, format, keep_runs)
+    let format = Format::of(lines.decimals(), lines.inch()).with_decimals(decimals);
+    out.restart().map_err(|e| ProgramError::Read(Error::io(e, "output")))?;
+    let mut again = StreamBlocks::new(name, open().map_err(ProgramError::Read)?);
+    fit_blocks(&mut again, VecDeque::new(), out, opts, format, keep_runs)
 }
 
-/// Fits every run of the blocks `lines` reads from `source` (their spans index it) under
-/// `format` and writes the result.
-fn fit_blocks(
-    source: &str,
-    lines: &mut impl Iterator<Item = camkit::error::Result<Block>>,
+/// Fits every run of the blocks `pending` holds and then `lines` reads under `format` and
+/// writes the result to `out`, run by run.
+fn fit_blocks<R: BufRead>(
+    lines: &mut StreamBlocks<'_, R>,
+    mut pending: VecDeque<Block>,
+    out: &mut dyn Write,
     opts: &Options,
     format: Format,
     keep_runs: bool,
-) -> Result<(Vec<u8>, Stats, Vec<FittedRun>), ProgramError> {
+) -> Result<(Stats, Vec<FittedRun>), ProgramError> {
     let mut w = Writer::new(format.decimals, format.centre_decimals, format.e_decimals);
-    w.out.reserve(source.len());
     let mut stats = Stats::default();
-    let mut input_moves = 0;
-    let mut read = || -> Result<Option<Block>, ProgramError> {
-        let block = lines.next().transpose().map_err(ProgramError::Read)?;
-        input_moves += usize::from(matches!(block, Some(Block::Move(_))));
-        Ok(block)
-    };
+    let mut input_moves = pending.iter().filter(|b| matches!(b, Block::Move(_))).count();
     let mut runs = Vec::new();
     // A run's blocks from its head (moves and the comment lines among them), blocks read past a
-    // run's end to be looked at again, the run's points and the window index of each.
+    // run's end to be looked at again (`pending`), the run's points and the window index of each.
     let mut window: Vec<Block> = Vec::new();
-    let mut pending: VecDeque<Block> = VecDeque::new();
     let mut pts: Vec<P3> = Vec::new();
     let mut from: Vec<usize> = Vec::new();
     let mut scratch = segment::Scratch::default();
     let mut written = 0;
-    while let Some(block) = pending.pop_front().map_or_else(&mut read, |b| Ok(Some(b)))? {
+    let flush = |w: &mut Writer, out: &mut dyn Write| {
+        out.write_all(&w.out).map_err(|e| ProgramError::Read(Error::io(e, "output")))?;
+        w.out.clear();
+        Ok::<(), ProgramError>(())
+    };
+    while let Some(block) = next(&mut pending, lines, &mut input_moves)? {
+        // Text before the oldest block still held (this one; `pending` follows it) is not needed.
+        lines.release(block.span().start);
+        if w.out.len() >= 1 << 16 {
+            flush(&mut w, out)?;
+        }
         let head = match &block {
             Block::Move(m) if can_start(m) => m.clone(),
             _ => {
-                w.verbatim(&source[block.span()], &block);
+                w.verbatim(lines.text(block.span()), &block);
                 written += usize::from(matches!(block, Block::Move(_)));
                 continue;
             }
@@ -172,7 +189,7 @@ fn fit_blocks(
         window.clear();
         window.push(block);
         let mut end = 0;
-        while let Some(next) = pending.pop_front().map_or_else(&mut read, |b| Ok(Some(b)))? {
+        while let Some(next) = next(&mut pending, lines, &mut input_moves)? {
             match &next {
                 Block::Other(o) if o.remark_only => {}
                 Block::Move(m) if continues(&head, m, opts) => end = window.len(),
@@ -217,7 +234,7 @@ fn fit_blocks(
             written += 1;
             if single {
                 for b in &run[lo..=hi] {
-                    w.verbatim(&source[b.span()], b);
+                    w.verbatim(lines.text(b.span()), b);
                 }
                 continue;
             }
@@ -244,7 +261,7 @@ fn fit_blocks(
             };
             w.motion(&out, &head.modes);
             // Comment lines among the piece's blocks follow it, in order.
-            remarks(&mut w, source, &run[lo..=hi]);
+            remarks(&mut w, lines, &run[lo..=hi]);
         }
         stats.points += pts.len();
         stats.add_pieces(pieces);
@@ -252,9 +269,25 @@ fn fit_blocks(
             runs.push(FittedRun { pts: pts.clone(), pieces: pieces.to_vec() });
         }
     }
+    flush(&mut w, out)?;
     stats.input_moves = input_moves;
     stats.output_moves = written;
-    Ok((w.out, stats, runs))
+    Ok((stats, runs))
+}
+
+/// The next block: one read before and held in `pending`, or a new one from `lines` (counted in
+/// `input_moves` if a move).
+fn next<R: BufRead>(
+    pending: &mut VecDeque<Block>,
+    lines: &mut StreamBlocks<'_, R>,
+    input_moves: &mut usize,
+) -> Result<Option<Block>, ProgramError> {
+    if let Some(b) = pending.pop_front() {
+        return Ok(Some(b));
+    }
+    let block = lines.next().transpose().map_err(ProgramError::Read)?;
+    *input_moves += usize::from(matches!(block, Some(Block::Move(_))));
+    Ok(block)
 }
 
 /// The motion block, if `b` is one.
@@ -263,12 +296,12 @@ fn as_move(b: &Block) -> Option<&MoveBlock> {
 }
 
 /// Copies the comment-only blocks among `blocks`.
-fn remarks(w: &mut Writer, source: &str, blocks: &[Block]) {
+fn remarks<R: BufRead>(w: &mut Writer, lines: &StreamBlocks<'_, R>, blocks: &[Block]) {
     for b in blocks {
         if let Block::Other(o) = b
             && o.remark_only
         {
-            w.verbatim(&source[b.span()], b);
+            w.verbatim(lines.text(b.span()), b);
         }
     }
 }
@@ -294,7 +327,10 @@ mod tests {
     }
 
     fn fit(text: &str, opts: &Options, decimals: Option<u32>) -> (String, Stats) {
-        let Ok((out, stats, _)) = fit_source("t.nc", text, opts, decimals, false) else { panic!("fit failed") };
+        let mut out = Vec::new();
+        let Ok((stats, _)) = fit_source("t.nc", &mut || Ok(text.as_bytes()), &mut out, opts, decimals, false) else {
+            panic!("fit failed")
+        };
         (String::from_utf8(out).unwrap(), stats)
     }
 
@@ -320,7 +356,7 @@ mod tests {
         let (out, stats) = fit(&text, &opts, None);
         assert!(out.contains("X9000.00037"), "{}", &out[out.len() - 120..]);
         assert!(stats.largest_deviation <= opts.tol);
-        let err = fit_source("t.nc", &text, &opts, Some(3), false).err();
+        let err = fit_source("t.nc", &mut || Ok(text.as_bytes()), &mut Vec::new(), &opts, Some(3), false).err();
         assert!(
             matches!(err, Some(ProgramError::Fit(GcodeError { line, .. })) if line as usize == GUESS_LINES + 14),
             "{err:?}"
@@ -330,7 +366,10 @@ mod tests {
     #[test]
     fn a_bad_word_anywhere_is_the_reader_s_error() {
         let text = program(GUESS_LINES + 10, "G1 X1 Q\n");
-        let Some(ProgramError::Read(e)) = fit_source("t.nc", &text, &Options::default(), None, false).err() else {
+        let mut open = || Ok(text.as_bytes());
+        let Some(ProgramError::Read(e)) =
+            fit_source("t.nc", &mut open, &mut Vec::new(), &Options::default(), None, false).err()
+        else {
             panic!("a read error expected")
         };
         assert!(e.to_string().contains(&format!("t.nc:{}", GUESS_LINES + 14)), "{e}");

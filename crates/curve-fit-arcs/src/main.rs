@@ -4,12 +4,13 @@ use camkit::cli::{self, IoArgs, Kind, positive};
 use camkit::contour::load::{ContourArgs, InputKind};
 use camkit::error::{Error, Location, Result};
 use camkit::geom::Plane;
-use camkit::io::{Input, Output, write_atomic};
+use camkit::io::{Input, Output, Source, Stream, write_atomic};
 use camkit::report::Report;
 use camkit::table::{self, Col, WriteOptions};
 use clap::{Parser, ValueEnum};
 use curve_fit_arcs::gcode_runs::{self, ProgramError};
 use curve_fit_arcs::{Method, Options, Stats, Sweep, plot, table_runs};
+use std::io::BufRead;
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Instant;
@@ -155,11 +156,15 @@ fn options(args: &Args) -> Result<Options> {
 
 fn run(args: Args) -> Result<()> {
     let opts = options(&args)?;
-    let started = Instant::now();
     let contour_opts = args.contours.options(true)?;
-    let mut input = Input::open(&args.io.input)?;
-    let from = if contour_opts.from.resolve(&input) == InputKind::Gcode { Kind::Gcode } else { Kind::Table };
+    let from =
+        if contour_opts.from.resolve_name(&args.io.input) == InputKind::Gcode { Kind::Gcode } else { Kind::Table };
     let to = if args.to == Kind::Auto { from } else { args.to };
+    if from == Kind::Gcode && to == Kind::Gcode {
+        return run_gcode(&args, &opts);
+    }
+    let started = Instant::now();
+    let mut input = Input::open(&args.io.input)?;
     let bytes_in = input.data.len();
     let mut out = Output::new(args.io.output.as_deref());
     let progress = args.io.progress(0, "fitting arcs");
@@ -168,25 +173,14 @@ fn run(args: Args) -> Result<()> {
         if source.trim().is_empty() {
             return Err(Error::input("empty input: no G-code").at(Location::file(&input.name)));
         }
-        if to == Kind::Gcode {
-            let keep_runs = args.svg.is_some() || args.lower_bound;
-            let (text, stats, runs) = gcode_runs::fit_source(&input.name, &source, &opts, args.decimals, keep_runs)
-                .map_err(|e| match e {
-                    ProgramError::Read(e) => e,
-                    ProgramError::Fit(e) => unfittable(&input.name, u64::from(e.line), e.cause.deviation, &opts),
-                })?;
-            out.buf = text;
-            (stats, runs)
-        } else {
-            let program = camkit::gcode::read(&input.name, source)?;
-            let (t, skipped) = camkit::gcode::program_to_table(&program);
-            if skipped > 0 {
-                cli::warn(&format!(
-                    "{skipped} non-motion blocks (comments, M/S/T words, other G codes) are not carried into the table"
-                ));
-            }
-            fit_to_table(&t, &opts, &args, &input, &mut out)?
+        let program = camkit::gcode::read(&input.name, source)?;
+        let (t, skipped) = camkit::gcode::program_to_table(&program);
+        if skipped > 0 {
+            cli::warn(&format!(
+                "{skipped} non-motion blocks (comments, M/S/T words, other G codes) are not carried into the table"
+            ));
         }
+        fit_to_table(&t, &opts, &args, &input, &mut out)?
     } else {
         let (t, skipped) = camkit::contour::load::table(&input, &contour_opts)?;
         if let Some((kind, line)) = skipped.first() {
@@ -213,6 +207,60 @@ fn run(args: Args) -> Result<()> {
         }
     };
     progress.finish();
+    let bytes_out = out.buf.len();
+    finish(&args, &opts, &input.name, &stats, &runs, started, bytes_in, bytes_out)?;
+    out.commit()
+}
+
+/// G-code to G-code, streamed: read, fitted and written run by run, never the whole program in
+/// memory (but the runs, for --svg or --lower-bound).
+fn run_gcode(args: &Args, opts: &Options) -> Result<()> {
+    let started = Instant::now();
+    let source = Source::open(&args.io.input)?;
+    if blank(source.reader()?).map_err(|e| Error::io(e, &source.name))? {
+        return Err(Error::input("empty input: no G-code").at(Location::file(&source.name)));
+    }
+    let mut out = Stream::new(args.io.output.as_deref())?;
+    let progress = args.io.progress(0, "fitting arcs");
+    let keep_runs = args.svg.is_some() || args.lower_bound;
+    let (stats, runs) =
+        gcode_runs::fit_source(&source.name, &mut || source.reader(), &mut out, opts, args.decimals, keep_runs)
+            .map_err(|e| match e {
+                ProgramError::Read(e) => e,
+                ProgramError::Fit(e) => unfittable(&source.name, u64::from(e.line), e.cause.deviation, opts),
+            })?;
+    progress.finish();
+    finish(args, opts, &source.name, &stats, &runs, started, source.len()? as usize, out.len() as usize)?;
+    out.commit()
+}
+
+/// True if `text` holds nothing but white space.
+fn blank(mut text: impl BufRead) -> std::io::Result<bool> {
+    loop {
+        let chunk = text.fill_buf()?;
+        if chunk.is_empty() {
+            return Ok(true);
+        }
+        if !chunk.iter().all(u8::is_ascii_whitespace) {
+            return Ok(false);
+        }
+        let n = chunk.len();
+        text.consume(n);
+    }
+}
+
+/// Checks the tolerance held, then writes the plot and the report.
+#[allow(clippy::too_many_arguments)]
+fn finish(
+    args: &Args,
+    opts: &Options,
+    name: &str,
+    stats: &Stats,
+    runs: &[curve_fit_arcs::FittedRun],
+    started: Instant,
+    bytes_in: usize,
+    bytes_out: usize,
+) -> Result<()> {
     if !camkit::tol::within(stats.largest_deviation, opts.tol) {
         return Err(Error::check(format!(
             "largest deviation {:.6} mm exceeds --tol {} mm",
@@ -222,18 +270,17 @@ fn run(args: Args) -> Result<()> {
     let seconds = started.elapsed().as_secs_f64();
     if let Some(path) = &args.svg {
         let plane = opts.planes[0];
-        let title =
-            format!("{}: {} moves → {} (tol {} mm)", input.name, stats.input_moves, stats.output_moves, opts.tol);
-        write_atomic(path, plot::plot(&runs, plane, &title).to_svg(1000.0).as_bytes())?;
+        let title = format!("{}: {} moves → {} (tol {} mm)", name, stats.input_moves, stats.output_moves, opts.tol);
+        write_atomic(path, plot::plot(runs, plane, &title).to_svg(1000.0).as_bytes())?;
     }
     if let Some(path) = &args.io.report {
-        let mut r = report(&stats, &opts, seconds, bytes_in, out.buf.len());
+        let mut r = report(stats, opts, seconds, bytes_in, bytes_out);
         if args.lower_bound {
-            r.set("moves_lower_bound", curve_fit_arcs::moves_lower_bound(&stats, &runs, &opts));
+            r.set("moves_lower_bound", curve_fit_arcs::moves_lower_bound(stats, runs, opts));
         }
         r.write(path)?;
     }
-    out.commit()
+    Ok(())
 }
 
 fn fit_to_table(

@@ -597,6 +597,7 @@ mod tests {
     fn job(stock_top: f64, safe: f64, ramp: Option<f64>) -> Job {
         Job {
             file: "s.json".into(),
+            source: String::new(),
             tool: tool(),
             tool_file: "t.json".into(),
             stock: Stock::Box { min: P3::new(0.0, 0.0, -30.0), max: P3::new(100.0, 60.0, stock_top) },

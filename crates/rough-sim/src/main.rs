@@ -276,8 +276,8 @@ fn conditions(a: &CondArgs) -> Result<(Conditions, Option<(f64, f64)>)> {
     if a.flutes == Some(0) {
         return Err(Error::input("--flutes must be at least 1, got 0"));
     }
-    doc.validate(&input.name)?;
-    let mut cutter = Cutter::from_tool(&doc, &input.name, a.flutes)?;
+    doc.validate(&input.name).map_err(|e| camkit::json::at_value(&input, e))?;
+    let mut cutter = Cutter::from_tool(&doc, &input.name, a.flutes).map_err(|e| camkit::json::at_value(&input, e))?;
     budget::check_radius(cutter.radius, if a.radius.is_some() { "--radius" } else { &input.name })?;
     cutter.rotation = if a.rotation == Sense::Ccw { Rotation::Ccw } else { Rotation::Cw };
     let (fz, speeds) = match (a.feed_per_tooth, a.feed, a.spindle) {
@@ -554,12 +554,12 @@ fn flat_tip(a: FlatArgs) -> Result<()> {
 
 fn zmap_cmd(a: ZmapArgs) -> Result<()> {
     let tool_input = Input::open(&a.tool)?;
-    let doc: Tool = camkit::json::from_input(&tool_input)?;
-    doc.validate(&tool_input.name)?;
+    let doc: Tool = camkit::json::checked(&tool_input, Tool::validate)?;
     if a.flutes == Some(0) {
         return Err(Error::input("--flutes must be at least 1, got 0"));
     }
-    let mut cutter = Cutter::from_tool(&doc, &tool_input.name, a.flutes)?;
+    let mut cutter =
+        Cutter::from_tool(&doc, &tool_input.name, a.flutes).map_err(|e| camkit::json::at_value(&tool_input, e))?;
     budget::check_radius(cutter.radius, &tool_input.name)?;
     cutter.rotation = if a.rotation == Sense::Ccw { Rotation::Ccw } else { Rotation::Cw };
     let spindle = positive(a.spindle, "--spindle")?;

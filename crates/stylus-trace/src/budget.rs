@@ -128,7 +128,9 @@ pub fn drop_length(area: &Region, height: f64, radius: f64) -> f64 {
 /// over the area at the longest step; the samples where chords are checked by drops, one every
 /// min(longest step, r/4), by the tracer over the area and by the coverage check along the whole
 /// of every line (which holds a line's samples at once, in every thread); and a drop at least per
-/// line. Every point is checked by a drop too, so points and drops cost [`drop_length`] each.
+/// line. The line over the model's top climbs to it and comes down: the model's height twice at
+/// the longest step (beside a stray vertex far up, a sliver a million mm high, this is where the
+/// hours go). Every point is checked by a drop too, so points and drops cost [`drop_length`] each.
 #[allow(clippy::too_many_arguments)]
 pub fn scan(
     lines: f64,
@@ -144,7 +146,7 @@ pub fn scan(
     let along = |r: &Region| (r.x1 - r.x0) * c.abs() + (r.y1 - r.y0) * s.abs();
     let across = (area.x1 - area.x0) * s.abs() + (area.y1 - area.y0) * c.abs();
     let crossing = lines.min(across / pick + 1.0);
-    let points = crossing * along(area) / steps.max_step;
+    let points = (crossing * along(area) + 2.0 * height) / steps.max_step;
     let spacing = crate::scan::sample_spacing(stylus, steps);
     let traced_samples = crossing * along(area) / spacing;
     let line_samples = along(region) / spacing;
@@ -199,7 +201,7 @@ mod tests {
         let area = Region { x0: -100.0, x1: 100.0, y0: -100.0, y1: 100.0 };
         assert_eq!(scan_lines(&area, 0.0, 0.5), 401.0);
         let need = scan(401.0, &area, &area, 200.0, 0.0, 0.5, &STYLUS, &STEPS);
-        let points = 401.0 * 200.0 / STEPS.max_step;
+        let points = (401.0 * 200.0 + 2.0 * 200.0) / STEPS.max_step;
         assert!(points < 54_429.0 && 2.0 * points > 54_429.0, "{points}");
         let work = 54_429.0 + 94_128.0 + 39_699.0;
         assert!(need.points < work && 2.0 * need.points > work, "{}", need.points);
@@ -226,5 +228,23 @@ mod tests {
         // A sliver wall 1e6 mm up over a 50 mm part: each drop costs 2e4 ordinary ones.
         assert_eq!(drop_length(&area, 1e6, 5.0), 1e6 / 40.0);
         assert_eq!(drop_length(&area, 30.0, 5.0), 1.0);
+    }
+
+    /// A 40 mm dome whose STL has one vertex 1e6 mm up (fuzz-flagged files that ran for hours
+    /// under an estimate of 1.9e7): the line over it climbs 1e6 mm and back, 1e6 points of
+    /// 2.5e4 drops each, far past the default bound; the dome alone stays far below it.
+    #[test]
+    fn a_stray_vertex_far_up_is_refused_by_its_climb() {
+        let budget = Budget { memory: 2.147e9, points: DEFAULT_POINTS };
+        let stylus = Stylus { radius: 5.0, contact_tol: 1e-4 };
+        let steps = Steps { chord_tol: 1e-3, max_step: 2.0, min_step: 1e-4 };
+        let area = Region { x0: -20.0, x1: 20.0, y0: -20.0, y1: 20.0 };
+        let lines = scan_lines(&area, 0.0, 5.0);
+        let spike = scan(lines, &area, &area, 1e6 + 11.0, 0.0, 5.0, &stylus, &steps);
+        assert!(spike.points > 2e10, "{}", spike.points);
+        let e = spike.check(&budget, "scan").unwrap_err();
+        assert!(e.to_string().contains("--max-points"), "{e}");
+        let dome = scan(lines, &area, &area, 20.0 + 11.0, 0.0, 5.0, &stylus, &steps);
+        assert!(dome.points < 1e-4 * DEFAULT_POINTS, "{}", dome.points);
     }
 }

@@ -88,14 +88,19 @@ fn unit<'de, D: Deserializer<'de>>(d: D) -> std::result::Result<Option<[f64; 3]>
 /// Reads the shape document (or the frame document with a `fit`) at `path`.
 pub fn read_shape(path: &str) -> Result<Shape> {
     let input = Input::open(path)?;
-    let peek: serde_json::Value = from_input(&input)?;
+    shape_of(&input).map_err(|e| camkit::json::at_value(&input, e))
+}
+
+/// The shape `input` holds (a shape document, or a frame document with a `fit`).
+fn shape_of(input: &Input) -> Result<Shape> {
+    let peek: serde_json::Value = from_input(input)?;
     if peek.get("shape").is_some() || peek.get("fit").is_none() && peek.get("xc").is_none() {
-        let doc: ShapeDoc = from_input(&input)?;
+        let doc: ShapeDoc = from_input(input)?;
         return doc.shape(&input.name, "");
     }
-    let frame: Frame = from_input(&input)?;
+    let frame: Frame = from_input(input)?;
     frame.validate(&input.name)?;
-    let fit: FitOf = from_input(&input)?;
+    let fit: FitOf = from_input(input)?;
     match fit.fit {
         Some(doc) => doc.shape(&input.name, "fit."),
         None => Err(field_error(&input.name, "fit", "the frame document holds no fit (a shape)")),

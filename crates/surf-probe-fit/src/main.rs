@@ -4,10 +4,10 @@ use camkit::cli::{self, IoArgs, positive, within};
 use camkit::doc::machine::Machine;
 use camkit::error::{Error, Location, Result};
 use camkit::geom::{P3, V3};
-use camkit::io::{Input, Output};
+use camkit::io::{Input, Output, Stream};
 use camkit::kinematics::{Chain, Joints, Link};
 use camkit::report::Report;
-use camkit::table::{self, Col, Field, Move, Row, Schema, Table, WriteOptions};
+use camkit::table::{self, Col, Field, Move, Row, RowWriter, Schema, Table, WriteOptions};
 use clap::{Parser, Subcommand, ValueEnum};
 use std::collections::HashMap;
 use std::path::PathBuf;
@@ -422,17 +422,23 @@ fn run_map(args: MapArgs) -> Result<()> {
     let doc: Outlines = camkit::json::from_input(&input)?;
     for (k, part) in doc.parts.iter().enumerate() {
         if part.len() < 2 || part.iter().flatten().any(|v| !v.is_finite()) {
-            return Err(camkit::json::field_error(
-                &input.name,
-                &format!("parts[{k}]"),
-                "an outline needs at least two finite [lon, lat] points",
+            return Err(camkit::json::at_value(
+                &input,
+                camkit::json::field_error(
+                    &input.name,
+                    &format!("parts[{k}]"),
+                    "an outline needs at least two finite [lon, lat] points",
+                ),
             ));
         }
         if let Some(j) = part.iter().position(|p| p[0].abs() > 360.0 || p[1].abs() > 90.0) {
-            return Err(camkit::json::field_error(
-                &input.name,
-                &format!("parts[{k}][{j}]"),
-                format!("[lon, lat] must lie within ±360° and ±90°, got {:?}", part[j]),
+            return Err(camkit::json::at_value(
+                &input,
+                camkit::json::field_error(
+                    &input.name,
+                    &format!("parts[{k}][{j}]"),
+                    format!("[lon, lat] must lie within ±360° and ±90°, got {:?}", part[j]),
+                ),
             ));
         }
     }
@@ -707,20 +713,29 @@ fn run_raster(args: RasterArgs) -> Result<()> {
     let (fx, fy) = (((x1 - x0) / step).floor(), ((y1 - y0) / step).floor());
     args.limit.check((fx + 1.0) * (fy + 1.0), &format!("the raster of --x, --y at --step {step}"))?;
     let (nx, ny) = (fx as usize, fy as usize);
-    let mut t = pose_table(&[]);
+    // Written row by row as made: the raster is never held.
+    let t = pose_table(&[]);
+    let mut out = Stream::new(args.out.output.as_deref())?;
+    let mut w = RowWriter::new(&t.schema, WriteOptions::default());
+    let mut row = Row::at(0, P3::origin());
+    row.tag = "raster".into();
     for j in 0..=ny {
         let y = y0 + j as f64 * step;
         for k in 0..=nx {
             let i = if j % 2 == 0 { k } else { nx - k };
-            let mut row = Row::at(j as i64, P3::new(x0 + i as f64 * step, y, args.z));
+            row.path = j as i64;
+            row.pos = P3::new(x0 + i as f64 * step, y, args.z);
             row.mv = if k == 0 { Move::Rapid } else { Move::Line };
-            row.tag = "raster".into();
-            t.rows.push(row);
+            w.row(&mut out, &row)?;
         }
     }
+    w.finish(&mut out)?;
     let mut report = Report::new("surf-probe-fit");
-    report.set("command", "raster").set("poses", t.rows.len()).set("lines", ny + 1);
-    write_table(&t, &args.out, &report)
+    report.set("command", "raster").set("poses", (nx + 1) * (ny + 1)).set("lines", ny + 1);
+    if let Some(path) = &args.out.report {
+        report.write(path)?;
+    }
+    out.commit()
 }
 
 fn run_simulate(args: SimulateArgs) -> Result<()> {

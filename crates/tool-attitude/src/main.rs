@@ -6,7 +6,7 @@ use camkit::doc::{Tool, ToolKind};
 use camkit::error::{Error, Location, Result};
 use camkit::geom::{P3, V3};
 use camkit::io::{Input, Output};
-use camkit::json::field_error;
+use camkit::json::{at_value, field_error};
 use camkit::model::Model;
 use camkit::report::Report;
 use camkit::table::{self, Col, Field, Table, WriteOptions};
@@ -370,8 +370,7 @@ fn run_fixed(args: &Args, tool: &Tool, tool_file: &str, axis: V3, started: Insta
 fn run(args: Args) -> Result<()> {
     let started = Instant::now();
     let tool_input = Input::open(&args.tool)?;
-    let tool: Tool = camkit::json::from_input(&tool_input)?;
-    tool.validate(&tool_input.name)?;
+    let tool: Tool = camkit::json::checked(&tool_input, Tool::validate)?;
     if let Some(text) = &args.axis {
         if args.decimals.is_some_and(|d| d > 12) {
             return Err(Error::input("--decimals must be at most 12"));
@@ -380,9 +379,9 @@ fn run(args: Args) -> Result<()> {
             return Err(Error::input(format!("--gouge-tol must be a number ≥ 0, got {}", args.gouge_tol)));
         }
         let axis = fixed_axis(text)?;
-        return run_fixed(&args, &tool, &tool_input.name, axis, started);
+        return run_fixed(&args, &tool, &tool_input.name, axis, started).map_err(|e| at_value(&tool_input, e));
     }
-    let setup = setup(&args, &tool, &tool_input.name)?;
+    let setup = setup(&args, &tool, &tool_input.name).map_err(|e| at_value(&tool_input, e))?;
     let part = load_part(&args, &tool, setup.length)?;
     let model = part.as_ref().map(|p| &p.model);
     let input = Input::open(&args.io.input)?;

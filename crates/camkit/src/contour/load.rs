@@ -30,7 +30,13 @@ pub enum InputKind {
 impl InputKind {
     /// `Auto` decided by the name of `input`; the others as they are.
     pub fn resolve(self, input: &Input) -> InputKind {
-        match (self, input.extension().as_str()) {
+        self.resolve_name(&input.name)
+    }
+
+    /// `Auto` decided by a file name's extension (any case); the others as they are.
+    pub fn resolve_name(self, name: &str) -> InputKind {
+        let extension = std::path::Path::new(name).extension().and_then(|e| e.to_str()).unwrap_or("");
+        match (self, extension.to_ascii_lowercase().as_str()) {
             (InputKind::Auto, "dxf") => InputKind::Dxf,
             (InputKind::Auto, "svg") => InputKind::Svg,
             (InputKind::Auto, "nc" | "ngc" | "gcode" | "gco" | "g" | "tap" | "cnc") => InputKind::Gcode,

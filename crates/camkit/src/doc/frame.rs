@@ -57,9 +57,7 @@ impl Frame {
     /// Reads and validates a frame document.
     pub fn read(path: &str) -> Result<Frame> {
         let input = crate::io::Input::open(path)?;
-        let frame: Frame = crate::json::document(&input)?;
-        frame.validate(&input.name)?;
-        Ok(frame)
+        crate::json::checked(&input, Frame::validate)
     }
 }
 

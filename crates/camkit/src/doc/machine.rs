@@ -521,7 +521,7 @@ impl Machine {
     pub fn read(path: &str) -> Result<(Machine, Chain)> {
         let input = crate::io::Input::open(path)?;
         let m: Machine = crate::json::document(&input)?;
-        let chain = m.kinematics(&input.name)?;
+        let chain = m.kinematics(&input.name).map_err(|e| crate::json::at_value(&input, e))?;
         Ok((m, chain))
     }
 }
@@ -567,5 +567,17 @@ mod tests {
         assert!(e.to_string().contains("unknown field `colour`"), "{e}");
         let e = parse(r#"{"name": "x", "chain": [{"linear": true}], "spindle": {"mode": "axis"}}"#).unwrap_err();
         assert!(e.to_string().contains("(spindle.address)"), "{e}");
+    }
+
+    /// A value that parses but fails a check is named at its line and column (issue 20, D14).
+    #[test]
+    fn a_bad_value_names_its_line_and_column() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("m.json");
+        let text =
+            "{\"name\": \"x\", \"chain\": [\n  {\"rotary\": \"A\"},\n  {\"rotary\": \"D\"}, {\"linear\": true}]}";
+        std::fs::write(&p, text).unwrap();
+        let e = Machine::read(p.to_str().unwrap()).unwrap_err();
+        assert!(e.to_string().starts_with(&format!("{}:3:14 (chain[1].rotary): ", p.display())), "{e}");
     }
 }

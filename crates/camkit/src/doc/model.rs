@@ -415,9 +415,7 @@ fn check_knots(knots: Option<&[f64]>, n: usize, p: usize, path: &str, file: &str
 impl ModelDoc {
     /// Reads a model document (not its STL files) and validates it.
     pub fn from_input(input: &crate::io::Input) -> Result<ModelDoc> {
-        let doc: ModelDoc = crate::json::document(input)?;
-        doc.validate(&input.name)?;
-        Ok(doc)
+        crate::json::checked(input, ModelDoc::validate)
     }
 }
 
@@ -455,7 +453,7 @@ mod tests {
             parse(r#"{"surfaces": [{"type": "sphere", "centre": [0,0,0], "radius": 1, "colour": 2}]}"#).unwrap_err();
         assert!(e.to_string().contains("unknown field `colour`"), "{e}");
         let e = parse(r#"{"surfaces": [{"type": "sphere", "centre": [0,0,0], "radius": -1}]}"#).unwrap_err();
-        assert_eq!(e.to_string(), "m.json (surfaces[0].radius): radius must be a positive number of mm, got -1");
+        assert_eq!(e.to_string(), "m.json:1:63 (surfaces[0].radius): radius must be a positive number of mm, got -1");
         let e = parse(r#"{"surfaces": [{"type": "bspline", "control_points": [[[0,0,0],[0,1,0]],[[1,0,0]]]}]}"#)
             .unwrap_err();
         assert!(e.to_string().contains("(surfaces[0].control_points[1])"), "{e}");
@@ -475,5 +473,13 @@ mod tests {
         let e = nurbs("[[1, 2, 3], [1, 1]]").unwrap_err();
         assert!(e.to_string().contains("(surfaces[0].weights): weights must have the net's shape (2 × 2)"), "{e}");
         assert!(parse(r#"{"surfaces": []}"#).unwrap_err().to_string().contains("at least one surface"));
+    }
+
+    /// A value that parses but fails a check is named at its line and column (issue 20, D14).
+    #[test]
+    fn a_bad_value_names_its_line_and_column() {
+        let e = parse("{\"surfaces\": [\n  {\"type\": \"sphere\", \"centre\": [0,0,0], \"radius\": 5},\n  {\"type\": \"sphere\", \"centre\": [0,0,0], \"radius\": -5}]}").unwrap_err();
+        assert!(e.to_string().starts_with("m.json:3:"), "{e}");
+        assert!(e.to_string().contains("(surfaces[1].radius)"), "{e}");
     }
 }

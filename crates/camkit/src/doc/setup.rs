@@ -224,6 +224,9 @@ pub enum Part {
 pub struct Job {
     /// The setup file, for messages.
     pub file: String,
+    /// The setup document's text (empty if not read from one), so that an error about one of its
+    /// fields found later names that field's line and column.
+    pub source: String,
     /// The tool.
     pub tool: Tool,
     /// The tool document's path, for messages.
@@ -265,7 +268,9 @@ impl Setup {
             Some(p) if path != "-" && !p.as_os_str().is_empty() => p.to_path_buf(),
             _ => PathBuf::from("."),
         };
-        setup.resolve(&input.name, &base)
+        let mut job = setup.resolve(&input.name, &base).map_err(|e| crate::json::at_value(&input, e))?;
+        job.source = input.text()?.to_string();
+        Ok(job)
     }
 
     /// Reads the files the setup names (relative to `base`) and checks every number.
@@ -450,6 +455,7 @@ impl Setup {
         };
         Ok(Job {
             file: file.to_string(),
+            source: String::new(),
             tool,
             tool_file,
             stock,
@@ -472,7 +478,11 @@ impl Setup {
 impl Job {
     /// The error for a field of this setup.
     pub fn error(&self, field: &str, message: impl Into<String>) -> Error {
-        Error::input(message).at(Location::file(&self.file).field(field))
+        let mut at = Location::file(&self.file);
+        if let Some((line, column)) = crate::json::locate(&self.source, field) {
+            at = at.line(line).column(column);
+        }
+        Error::input(message).at(at.field(field))
     }
 }
 
@@ -570,5 +580,16 @@ mod tests {
         .unwrap();
         let j = Setup::read(p.to_str().unwrap()).unwrap();
         assert_eq!(j.stock, Stock::Box { min: P3::new(-1.0, -2.0, -0.5), max: P3::new(11.0, 22.0, 5.5) });
+    }
+
+    /// A value that parses but fails a check is named at its line and column (issue 20, D14).
+    #[test]
+    fn a_bad_value_names_its_line_and_column() {
+        let text =
+            "{\"tool\": \"t.json\", \"stock\": {\"min\": [0, 0, 0]},\n \"clearance_height\": 20, \"safe_height\": 5}";
+        let e = job(text, &[TOOL]).unwrap_err();
+        assert!(e.to_string().contains("setup.json:1:29 (stock): "), "{e}");
+        let e = job(text, &[("t.json", r#"{"kind": "flat", "radius": -4}"#)]).unwrap_err();
+        assert!(e.to_string().contains("t.json:1:28 (radius): "), "{e}");
     }
 }

@@ -154,9 +154,7 @@ impl Tool {
     /// Reads and validates a tool document.
     pub fn read(path: &str) -> Result<Tool> {
         let input = crate::io::Input::open(path)?;
-        let tool: Tool = crate::json::document(&input)?;
-        tool.validate(&input.name)?;
-        Ok(tool)
+        crate::json::checked(&input, Tool::validate)
     }
 }
 
@@ -211,5 +209,15 @@ mod tests {
         assert!(e.to_string().contains("together"), "{e}");
         let e = parse(r#"{"kind": "flat", "radius": 4, "holder_diameter": 30, "holder_length": 40}"#).unwrap_err();
         assert!(e.to_string().contains("(length)"), "{e}");
+    }
+
+    /// A value that parses but fails a check is named at its line and column (issue 20, D14).
+    #[test]
+    fn a_bad_value_names_its_line_and_column() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("t.json");
+        std::fs::write(&p, "{\n  \"kind\": \"ball\",\n  \"radius\": 5,\n  \"flutes\": 0\n}").unwrap();
+        let e = Tool::read(p.to_str().unwrap()).unwrap_err();
+        assert_eq!(e.to_string(), format!("{}:4:13 (flutes): a tool needs at least one flute", p.display()));
     }
 }

@@ -9,7 +9,7 @@ mod table;
 mod write;
 
 pub use axes::{AXIS_LETTERS, AxisArc, AxisMove, AxisProgram, read_axes};
-pub use read::{Blocks, Decimals, read};
+pub use read::{Blocks, Decimals, StreamBlocks, read};
 pub use table::{program_to_table, table_to_program};
 pub use write::{OutMove, Writer};
 

@@ -144,15 +144,7 @@ impl<'a> Blocks<'a> {
     /// Blocks of `source`; `name` is used in error messages.
     pub fn new(name: &'a str, source: &'a str) -> Blocks<'a> {
         Blocks {
-            reader: Reader {
-                name,
-                modes: Modes::default(),
-                pos: [0.0; 3],
-                known: [false; 3],
-                virtual_frame: false,
-                e_mode_relative: false,
-                e_abs: None,
-            },
+            reader: Reader::new(name),
             bytes: source.as_bytes(),
             // A byte order mark some editors put first is not part of the program.
             line_start: if source.starts_with('\u{feff}') { 3 } else { 0 },
@@ -199,6 +191,111 @@ impl Iterator for Blocks<'_> {
     }
 }
 
+/// The blocks of a program read line by line from a stream: only the text not yet released is
+/// held (a filter that streams keeps the lines of one run), so a program of any size is read in
+/// the memory of its longest run. Spans are byte offsets from the start of the stream, as
+/// [`Blocks`] gives them; [`StreamBlocks::text`] shows a held block's line. The first error ends
+/// the sequence.
+pub struct StreamBlocks<'a, R> {
+    reader: Reader<'a>,
+    src: R,
+    /// Held text: the stream's bytes from offset `base` on.
+    text: Vec<u8>,
+    base: usize,
+    line_no: u32,
+    words: Vec<Word>,
+    decimals: Decimals,
+    inch: bool,
+    failed: bool,
+}
+
+impl<'a, R: std::io::BufRead> StreamBlocks<'a, R> {
+    /// Blocks read from `src`; `name` is used in error messages.
+    pub fn new(name: &'a str, src: R) -> StreamBlocks<'a, R> {
+        StreamBlocks {
+            reader: Reader::new(name),
+            src,
+            text: Vec::with_capacity(1 << 16),
+            base: 0,
+            line_no: 0,
+            words: Vec::with_capacity(16),
+            decimals: Decimals::default(),
+            inch: false,
+            failed: false,
+        }
+    }
+
+    /// The text of a held block's `span` (a line, without its line break).
+    pub fn text(&self, span: std::ops::Range<usize>) -> &str {
+        // Every line was checked to be UTF-8 when it was read.
+        std::str::from_utf8(&self.text[span.start - self.base..span.end - self.base]).unwrap_or_default()
+    }
+
+    /// Forgets the text before offset `upto`: no span before it is asked for again.
+    pub fn release(&mut self, upto: usize) {
+        let cut = upto.saturating_sub(self.base).min(self.text.len());
+        // Moved down only once the released part is large, so that it costs O(1) per byte.
+        if cut >= 1 << 16 && 2 * cut >= self.text.len() {
+            self.text.drain(..cut);
+            self.base += cut;
+        }
+    }
+
+    /// Most decimals seen in the blocks read so far.
+    pub fn decimals(&self) -> Decimals {
+        self.decimals
+    }
+
+    /// True if any block read so far is in inch (G20).
+    pub fn inch(&self) -> bool {
+        self.inch
+    }
+}
+
+impl<R: std::io::BufRead> Iterator for StreamBlocks<'_, R> {
+    type Item = Result<Block>;
+
+    fn next(&mut self) -> Option<Result<Block>> {
+        if self.failed {
+            return None;
+        }
+        let at = self.text.len();
+        let read = self.src.read_until(b'\n', &mut self.text);
+        let n = match read {
+            Ok(0) => return None,
+            Ok(n) => n,
+            Err(e) => {
+                self.failed = true;
+                return Some(Err(Error::io(e, self.reader.name)));
+            }
+        };
+        self.line_no += 1;
+        let name = self.reader.name;
+        let mut start = at;
+        let mut end = at + n;
+        if self.text[end - 1] == b'\n' {
+            end -= 1;
+        }
+        if end > start && self.text[end - 1] == b'\r' {
+            end -= 1;
+        }
+        // A byte order mark some editors put first is not part of the program.
+        if self.base + start == 0 && self.text[start..end].starts_with("\u{feff}".as_bytes()) {
+            start += 3;
+        }
+        if std::str::from_utf8(&self.text[start..at + n]).is_err() {
+            self.failed = true;
+            let loc = Location::file(name).line(u64::from(self.line_no));
+            return Some(Err(Error::input("text is not valid UTF-8").at(loc)));
+        }
+        let span = self.base + start..self.base + end;
+        let block = self.reader.block(&self.text[start..end], span, self.line_no, &mut self.words, &mut self.decimals);
+        self.failed = block.is_err();
+        self.inch |= self.reader.modes.units == Units::Inch;
+        Some(block)
+    }
+}
+
 struct Reader<'a> {
     name: &'a str,
     modes: Modes,
@@ -226,7 +323,20 @@ struct GEffects {
     g92: bool,
 }
 
-impl Reader<'_> {
+impl<'a> Reader<'a> {
+    /// A reader at the start of a program.
+    fn new(name: &'a str) -> Reader<'a> {
+        Reader {
+            name,
+            modes: Modes::default(),
+            pos: [0.0; 3],
+            known: [false; 3],
+            virtual_frame: false,
+            e_mode_relative: false,
+            e_abs: None,
+        }
+    }
+
     fn err(&self, line: u32, col: usize, word: &[u8], message: &str) -> Error {
         let word = String::from_utf8_lossy(word).into_owned();
         Error::input(message).at(Location::file(self.name).line(u64::from(line)).column(col as u64 + 1).field(word))

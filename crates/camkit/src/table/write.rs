@@ -1,7 +1,7 @@
 //! Writing the toolpath table: the schema's columns in order, numbers either shortest
 //! round-trip or fixed decimals.
 
-use super::{Col, Field, Row, Table};
+use super::{Col, Field, Row, Schema, Table};
 use crate::error::{Error, Result};
 use crate::geom::Plane;
 use crate::num::{push_fixed, push_shortest};
@@ -17,34 +17,62 @@ pub struct WriteOptions {
 
 /// Writes the table, header first.
 pub fn write(out: &mut dyn Write, table: &Table, opts: &WriteOptions) -> Result<()> {
-    let mut buf: Vec<u8> = Vec::with_capacity(1 << 16);
-    for (n, field) in table.schema.fields.iter().enumerate() {
-        if n > 0 {
-            buf.push(b',');
-        }
-        match field {
-            Field::Known(c) => buf.extend_from_slice(super::columns::spec(*c).name.as_bytes()),
-            Field::Extra(i) => push_text(&mut buf, &table.schema.extra_names[*i]),
-        }
-    }
-    buf.push(b'\n');
+    let mut w = RowWriter::new(&table.schema, *opts);
     for row in &table.rows {
-        for (n, field) in table.schema.fields.iter().enumerate() {
+        w.row(out, row)?;
+    }
+    w.finish(out)
+}
+
+/// A table written row by row as the rows are made, so that they need not be held: the header
+/// first, then each row, through a buffer of 64 kB.
+pub struct RowWriter<'a> {
+    schema: &'a Schema,
+    opts: WriteOptions,
+    buf: Vec<u8>,
+}
+
+impl<'a> RowWriter<'a> {
+    /// A writer of rows of `schema`, its header buffered.
+    pub fn new(schema: &'a Schema, opts: WriteOptions) -> RowWriter<'a> {
+        let mut buf: Vec<u8> = Vec::with_capacity(1 << 16);
+        for (n, field) in schema.fields.iter().enumerate() {
             if n > 0 {
                 buf.push(b',');
             }
             match field {
-                Field::Known(c) => push_value(&mut buf, row, *c, opts),
-                Field::Extra(i) => push_text(&mut buf, row.extra.get(*i).map_or("", String::as_str)),
+                Field::Known(c) => buf.extend_from_slice(super::columns::spec(*c).name.as_bytes()),
+                Field::Extra(i) => push_text(&mut buf, &schema.extra_names[*i]),
+            }
+        }
+        buf.push(b'\n');
+        RowWriter { schema, opts, buf }
+    }
+
+    /// Writes one row (to `out` once the buffer is full).
+    pub fn row(&mut self, out: &mut dyn Write, row: &Row) -> Result<()> {
+        let buf = &mut self.buf;
+        for (n, field) in self.schema.fields.iter().enumerate() {
+            if n > 0 {
+                buf.push(b',');
+            }
+            match field {
+                Field::Known(c) => push_value(buf, row, *c, &self.opts),
+                Field::Extra(i) => push_text(buf, row.extra.get(*i).map_or("", String::as_str)),
             }
         }
         buf.push(b'\n');
         if buf.len() >= 1 << 16 {
-            out.write_all(&buf).map_err(|e| Error::io(e, "output"))?;
+            out.write_all(buf).map_err(|e| Error::io(e, "output"))?;
             buf.clear();
         }
+        Ok(())
     }
-    out.write_all(&buf).map_err(|e| Error::io(e, "output"))
+
+    /// Writes what the buffer still holds.
+    pub fn finish(self, out: &mut dyn Write) -> Result<()> {
+        out.write_all(&self.buf).map_err(|e| Error::io(e, "output"))
+    }
 }
 
 fn push_num(buf: &mut Vec<u8>, v: f64, decimals: Option<u32>) {
