@@ -173,6 +173,7 @@ pub fn progress(quiet: bool, total: u64, what: &str) -> Progress {
     if !quiet && std::io::stderr().is_terminal() {
         // Shown only once styled and named, so its first frame is whole.
         p.bar.set_draw_target(indicatif::ProgressDrawTarget::stderr());
+        p.bar.tick();
         if total == 0 {
             p.bar.enable_steady_tick(std::time::Duration::from_millis(120));
         }
