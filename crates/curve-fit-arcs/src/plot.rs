@@ -22,7 +22,7 @@ pub fn plot(runs: &[FittedRun], plane: Plane, title: &str) -> Plot {
     if total <= MAX_DOTS {
         for run in runs {
             let flat: Vec<_> = run.pts.iter().map(|q| plane.split(q).0).collect();
-            p.dots(&flat, 1.0, Style::fill("#999", 0.7));
+            p.dots(&flat, 1.0, Style::fill("#999", 0.7).named("input points"));
         }
     }
     let mut joints = Vec::new();
@@ -33,27 +33,21 @@ pub fn plot(runs: &[FittedRun], plane: Plane, title: &str) -> Plot {
             let b = plane.split(&piece.end).0;
             match piece.shape {
                 Shape::Line => {
-                    p.polyline(&[a, b], Style::stroke(LINE, 2.2));
+                    p.polyline(&[a, b], Style::stroke(LINE, 2.2).named("line"));
                 }
                 Shape::Arc { centre, plane: arc_plane, ccw } => {
                     // Arcs in another plane are drawn by their end points only.
                     if arc_plane == plane {
                         let arc = Arc2::from_centre(centre, &a, &b, ccw, false);
-                        p.path(a, vec![Piece::Arc(arc)], false, Style::stroke(ARC, 2.2));
+                        p.path(a, vec![Piece::Arc(arc)], false, Style::stroke(ARC, 2.2).named("arc"));
                     } else {
-                        p.polyline(&[a, b], Style::stroke(ARC, 2.2).dashed("3 2"));
+                        p.polyline(&[a, b], Style::stroke(ARC, 2.2).dashed("3 2").named("arc in another plane (chord)"));
                     }
                 }
             }
             joints.push(b);
         }
     }
-    p.dots(&joints, 2.2, Style::fill("black", 1.0));
-    p.legend("line", Style::stroke(LINE, 2.2))
-        .legend("arc", Style::stroke(ARC, 2.2))
-        .legend("piece ends", Style::fill("black", 1.0));
-    if total <= MAX_DOTS {
-        p.legend("input points", Style::fill("#999", 0.7));
-    }
+    p.dots(&joints, 2.2, Style::fill("black", 1.0).named("piece ends"));
     p
 }
