@@ -16,6 +16,7 @@ mod simplify;
 use crate::geom::{Arc2, P2};
 use std::collections::{BTreeMap, HashSet};
 use std::fmt::Write;
+use std::hash::{Hash, Hasher};
 
 /// Largest distance (pixels) of a dropped polyline point from the drawn line.
 pub const THIN_PX: f64 = 0.25;
@@ -446,10 +447,13 @@ impl Plot {
         if self.axes {
             axes(&mut s, self, (min, max), pad, (frame_w, frame_h), &tx, &ty);
         }
+        let mut drawn = Drawn::new();
         for mark in &self.marks {
             match mark {
                 Mark::Path { start, pieces, closed, style } => {
-                    let d = path_data(*start, pieces, *closed, &tx, &ty, sx, sy);
+                    // Only open, unfilled paths skip segments drawn before (a fill needs its outline).
+                    let key = (!*closed && style.fill == "none").then(|| style_key(style));
+                    let d = path_data(*start, pieces, *closed, &tx, &ty, (sx, sy), &mut drawn, key);
                     let _ = writeln!(s, r#"<path d="{d}" {} stroke-linejoin="round"/>"#, style.attrs());
                 }
                 Mark::Dots { pts, radius_px, style } => {
@@ -585,42 +589,111 @@ fn axes(
     );
 }
 
-/// Path data of a path mark; runs of straight pieces are thinned to [`THIN_PX`].
+/// Pieces already drawn, by style and pixels (halves of a pixel): a segment's ends either way,
+/// an arc's ends, centre and sense.
+type Drawn = HashSet<(u64, [i64; 7])>;
+
+/// Path data being written: the pen skips pieces drawn before in the same style (`key`) and
+/// moves on to the next piece it draws.
+struct Pen<'a> {
+    d: String,
+    drawn: &'a mut Drawn,
+    key: Option<u64>,
+    lifted: bool,
+}
+
+impl Pen<'_> {
+    /// Draws a piece from `from` with signature `sig`, written by `cmd`, unless drawn before.
+    fn piece(&mut self, from: (f64, f64), sig: [i64; 7], cmd: impl FnOnce(&mut String)) {
+        if self.key.is_some_and(|k| !self.drawn.insert((k, sig))) {
+            self.lifted = true;
+            return;
+        }
+        if self.lifted {
+            let _ = write!(self.d, "M{:.1} {:.1}", from.0, from.1);
+            self.lifted = false;
+        }
+        cmd(&mut self.d);
+    }
+}
+
+/// Half-pixel units of a screen coordinate.
+fn half_px(v: f64) -> i64 {
+    (v * 2.0).round() as i64
+}
+
+/// Path data of a path mark. Runs of straight pieces are thinned to [`THIN_PX`]; consecutive
+/// arcs on one circle are drawn as one; a piece already drawn in the same style (`key`, if
+/// given) on the same pixels is skipped (the layers of a pocket seen from above are drawn once).
+#[allow(clippy::too_many_arguments)]
 fn path_data(
     start: P2,
     pieces: &[Piece],
     closed: bool,
     tx: &dyn Fn(f64) -> f64,
     ty: &dyn Fn(f64) -> f64,
-    sx: f64,
-    sy: f64,
+    (sx, sy): (f64, f64),
+    drawn: &mut Drawn,
+    key: Option<u64>,
 ) -> String {
-    let mut d = format!("M{:.1} {:.1}", tx(start.x), ty(start.y));
-    let mut run = vec![(tx(start.x), ty(start.y))];
-    let flush = |d: &mut String, run: &mut Vec<(f64, f64)>| {
-        for (x, y) in simplify::simplify(run, THIN_PX).iter().skip(1) {
-            let _ = write!(d, "L{x:.1} {y:.1}");
+    let screen = |p: P2| (tx(p.x), ty(p.y));
+    let mut pen = Pen { d: format!("M{:.1} {:.1}", tx(start.x), ty(start.y)), drawn, key, lifted: false };
+    let mut run = vec![screen(start)];
+    let mut arc: Option<Arc2> = None;
+    let lines = |pen: &mut Pen, run: &mut Vec<(f64, f64)>| {
+        for w in simplify::simplify(run, THIN_PX).windows(2) {
+            let (a, b) = ([half_px(w[0].0), half_px(w[0].1)], [half_px(w[1].0), half_px(w[1].1)]);
+            let sig = if a <= b { [a[0], a[1], b[0], b[1], 0, 0, 0] } else { [b[0], b[1], a[0], a[1], 0, 0, 0] };
+            pen.piece(w[0], sig, |d| {
+                let _ = write!(d, "L{:.1} {:.1}", w[1].0, w[1].1);
+            });
         }
         let last = run.last().copied();
         run.clear();
         run.extend(last);
     };
+    let arcs = |pen: &mut Pen, arc: &mut Option<Arc2>| {
+        if let Some(a) = arc.take() {
+            let (p, q) = (screen(a.point_at_fraction(0.0)), screen(a.point_at_fraction(1.0)));
+            let sig = [half_px(p.0), half_px(p.1), half_px(q.0), half_px(q.1), half_px(tx(a.c.x)), half_px(ty(a.c.y)), a.sweep.signum() as i64];
+            pen.piece(p, sig, |d| arc_commands(d, &a, tx, ty, sx, sy));
+        }
+    };
     for p in pieces {
         match p {
-            Piece::Line(q) => run.push((tx(q.x), ty(q.y))),
+            Piece::Line(q) => {
+                arcs(&mut pen, &mut arc);
+                run.push(screen(*q));
+            }
             Piece::Arc(a) => {
-                flush(&mut d, &mut run);
-                arc_commands(&mut d, a, tx, ty, sx, sy);
-                let e = a.point_at_fraction(1.0);
-                run = vec![(tx(e.x), ty(e.y))];
+                lines(&mut pen, &mut run);
+                let same_circle = |b: &Arc2| {
+                    ((b.c - a.c).norm() * sx).max((b.r - a.r).abs() * sx) < 0.05 && b.sweep * a.sweep > 0.0
+                };
+                match &mut arc {
+                    Some(b) if same_circle(b) => b.sweep += a.sweep,
+                    _ => {
+                        arcs(&mut pen, &mut arc);
+                        arc = Some(*a);
+                    }
+                }
+                run = vec![screen(a.point_at_fraction(1.0))];
             }
         }
     }
-    flush(&mut d, &mut run);
+    arcs(&mut pen, &mut arc);
+    lines(&mut pen, &mut run);
     if closed {
-        d.push('Z');
+        pen.d.push('Z');
     }
-    d
+    pen.d
+}
+
+/// A key telling styles apart for [`Drawn`].
+fn style_key(style: &Style) -> u64 {
+    let mut h = std::collections::hash_map::DefaultHasher::new();
+    (&style.stroke, style.width.to_bits(), &style.fill, &style.dash, style.opacity.to_bits()).hash(&mut h);
+    h.finish()
 }
 
 /// The cells of a height map, one path of rectangles per colour level.
@@ -737,10 +810,10 @@ fn colour_bar(s: &mut String, range: (f64, f64), label: &str, (x, y): (f64, f64)
     );
 }
 
-/// SVG arc commands for an arc; sweeps over 180° are split in two (SVG needs an unambiguous
+/// SVG arc commands for an arc; it is split into pieces under 180° (SVG needs an unambiguous
 /// large-arc flag).
 fn arc_commands(d: &mut String, a: &Arc2, tx: &dyn Fn(f64) -> f64, ty: &dyn Fn(f64) -> f64, sx: f64, sy: f64) {
-    let parts = if a.sweep.abs() > std::f64::consts::PI { 2 } else { 1 };
+    let parts = ((a.sweep.abs() / (0.99 * std::f64::consts::PI)).ceil() as usize).max(1);
     for k in 1..=parts {
         let e = a.point_at(a.start + a.sweep * k as f64 / parts as f64);
         // y is flipped on screen, so counter-clockwise in the world is clockwise on screen.
