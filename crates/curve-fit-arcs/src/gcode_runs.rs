@@ -249,7 +249,7 @@ fn fit_blocks(
         stats.points += pts.len();
         stats.add_pieces(pieces);
         if keep_runs {
-            runs.push(FittedRun { pts: pts.clone(), pieces: pieces.to_vec() });
+            runs.push(FittedRun { pts: pts.clone(), pieces: pieces.to_vec(), extrusion: e_rate(&head) });
         }
     }
     stats.input_moves = input_moves;
