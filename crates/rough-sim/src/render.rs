@@ -46,6 +46,8 @@ pub fn colour_map(map: &HeightMap, title: &str, bar: &str, figures: Option<&Figu
             }
         }
     }
+    // The colour bar spans every node, not only the cells' highest ones.
+    let (lo, hi) = map.h.iter().filter(|v| v.is_finite()).fold((f64::INFINITY, f64::NEG_INFINITY), |a, &v| (a.0.min(v), a.1.max(v)));
     let cell = (g.step * k as f64, g.step * k as f64);
     let title = match figures {
         Some(f) => format!(
@@ -60,6 +62,9 @@ pub fn colour_map(map: &HeightMap, title: &str, bar: &str, figures: Option<&Figu
     p.labels("x (mm)", "y (mm)").colour_bar(bar);
     let origin = P2::new(g.x0 - cell.0 / 2.0, g.y0 - cell.1 / 2.0);
     p.raster(Raster { origin, cell, nx, ny, values });
+    if lo.is_finite() {
+        p.colour_range(lo, hi);
+    }
     p.to_svg(900.0)
 }
 
