@@ -46,7 +46,20 @@ fn stylus_trace_draws_3d_views_coloured_by_the_written_z() {
     let model = data("stylus-trace/sphere-smoothing.json");
     w.run(
         "stylus-trace",
-        &[model.to_str().unwrap(), "--mode", "scan", "-r", "12.5", "--pick", "2", "--region=-20,20,-20,20", "--svg", "cl.svg", "-o", "cl.csv"],
+        &[
+            model.to_str().unwrap(),
+            "--mode",
+            "scan",
+            "-r",
+            "12.5",
+            "--pick",
+            "2",
+            "--region=-20,20,-20,20",
+            "--svg",
+            "cl.svg",
+            "-o",
+            "cl.csv",
+        ],
         b"",
     )
     .ok();
@@ -127,7 +140,12 @@ fn medial_trochoid_colours_engagement_in_degrees_up_to_the_largest_cutting_value
     bars_span(&seen, (0.0, f("largest_engagement_deg").max(f("link_engagement_deg"))), 1e-5, label);
     assert!(seen.drawn.contains("contour") && seen.drawn.contains("medial axis"));
     let seen = plot(&w, "o.svg");
-    bars_span(&seen, (0.0, f("offset_only_largest_engagement_deg").max(f("offset_only_link_engagement_deg"))), 1e-5, label);
+    bars_span(
+        &seen,
+        (0.0, f("offset_only_largest_engagement_deg").max(f("offset_only_link_engagement_deg"))),
+        1e-5,
+        label,
+    );
 }
 
 #[test]
@@ -153,8 +171,12 @@ fn post_6axis_plots_the_program_with_rapids_feeds_and_arcs() {
     assert!((1..=2).contains(&arcs(panels[0])), "{}", panels[0]);
     assert_eq!(arcs(panels[1]) + arcs(panels[2]), 0);
     // --reverse plots a program it reads.
-    w.run("post-6axis", &["p.nc", "--machine", machine.to_str().unwrap(), "--reverse", "--svg", "r.svg", "-o", "r.csv"], b"")
-        .ok();
+    w.run(
+        "post-6axis",
+        &["p.nc", "--machine", machine.to_str().unwrap(), "--reverse", "--svg", "r.svg", "-o", "r.csv"],
+        b"",
+    )
+    .ok();
     assert_eq!(plot(&w, "r.svg").drawn, seen.drawn);
 }
 
@@ -176,7 +198,10 @@ fn curve_fit_arcs_draws_a_print_in_3d_with_travel_apart() {
         if let Some(v) = word('Z') {
             z = v;
         }
-        if matches!(words.first(), Some(&("G1" | "G2" | "G3"))) && word('E').is_some_and(|e| e > 0.0) && word('X').is_some() {
+        if matches!(words.first(), Some(&("G1" | "G2" | "G3")))
+            && word('E').is_some_and(|e| e > 0.0)
+            && word('X').is_some()
+        {
             (lo, hi) = (lo.min(z), hi.max(z));
         }
     }
@@ -192,8 +217,12 @@ fn offset_profile_plot_is_small_and_its_legend_is_what_is_drawn() {
         csv.push_str(&format!("0,line,{x},0,{}\n", 10.0 * (x / 10.0).sin()));
     }
     w.write("profile.csv", csv);
-    w.run("offset", &["profile.csv", "--profile", "square", "--up", "z", "--radius", "1.5", "--svg", "s.svg", "-o", "s.csv"], b"")
-        .ok();
+    w.run(
+        "offset",
+        &["profile.csv", "--profile", "square", "--up", "z", "--radius", "1.5", "--svg", "s.svg", "-o", "s.csv"],
+        b"",
+    )
+    .ok();
     let seen = plot(&w, "s.svg");
     assert!(w.read("s.svg").len() < 200_000);
     assert!(seen.drawn.contains("profile") && seen.drawn.contains("tip path, offset (never cuts into the profile)"));

@@ -25,7 +25,8 @@ fn coloured(p: &mut Plot, a: &Analysed, width: f64) {
         last_move = i;
     }
     p.heat(&pts, &values, width);
-    p.colour_bar("path: engagement (°); entries above the top in its colour").colour_range(0.0, a.max_cutting.max(a.max_link));
+    p.colour_bar("path: engagement (°); entries above the top in its colour")
+        .colour_range(0.0, a.max_cutting.max(a.max_link));
 }
 
 /// The contours of `regions` in black.
@@ -69,7 +70,11 @@ pub fn plan_plot(title: &str, plan: &Plan, trochoidal: bool) -> Plot {
     match &plan.uncut {
         Some(u) => {
             contours(&mut p, &u.original);
-            outlines(&mut p, &plan.regions, &opened.named(&format!("opened contour ({:.3} mm disk rolled inside)", u.rho)));
+            outlines(
+                &mut p,
+                &plan.regions,
+                &opened.named(&format!("opened contour ({:.3} mm disk rolled inside)", u.rho)),
+            );
             for st in &u.stretches {
                 p.polyline(&st.points, uncut.clone());
             }
@@ -91,7 +96,10 @@ pub fn plan_plot(title: &str, plan: &Plan, trochoidal: bool) -> Plot {
             p.polyline(d, Style::stroke("#ff7f0e", 3.0).named("danger where no trochoid fits"));
         }
         for r in &plan.rests {
-            p.polygon(&r.outline(24), Style::fill("#2ca02c", 0.7).named("corner rest left to finishing (rounded wall pass)"));
+            p.polygon(
+                &r.outline(24),
+                Style::fill("#2ca02c", 0.7).named("corner rest left to finishing (rounded wall pass)"),
+            );
         }
     }
     p

@@ -388,7 +388,10 @@ fn patch(a: PatchArgs) -> Result<()> {
             "r {} mm, f {} mm, fz {:.3} mm, ζ {}°",
             cond.cutter.radius, cond.pick, cond.feed_per_tooth, a.cond.tilt
         );
-        write_atomic(path, render::colour_map(&map, &title, "h: height above the nominal surface (mm)", Some(&figs.map)).as_bytes())?;
+        write_atomic(
+            path,
+            render::colour_map(&map, &title, "h: height above the nominal surface (mm)", Some(&figs.map)).as_bytes(),
+        )?;
     }
     if let Some(path) = &a.profiles {
         write_atomic(path, &profiles_csv(&map, figs.map.max_at))?;

@@ -47,7 +47,11 @@ pub fn colour_map(map: &HeightMap, title: &str, bar: &str, figures: Option<&Figu
         }
     }
     // The colour bar spans every node, not only the cells' highest ones.
-    let (lo, hi) = map.h.iter().filter(|v| v.is_finite()).fold((f64::INFINITY, f64::NEG_INFINITY), |a, &v| (a.0.min(v), a.1.max(v)));
+    let (lo, hi) = map
+        .h
+        .iter()
+        .filter(|v| v.is_finite())
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |a, &v| (a.0.min(v), a.1.max(v)));
     let cell = (g.step * k as f64, g.step * k as f64);
     let title = match figures {
         Some(f) => format!(

@@ -72,8 +72,7 @@ pub fn table(model: &Model, paths: &[TracedPath], tag: &str, two: bool) -> Table
 /// The 3-D views of the traced stylus centres coloured by z (and, in two-surface mode, both
 /// contact lines under them).
 pub fn plot(paths: &[TracedPath], title: &str) -> Figure {
-    let centres: Vec<Path3> =
-        paths.iter().map(|p| Path3::by_z(p.points.iter().map(|q| q.centre).collect())).collect();
+    let centres: Vec<Path3> = paths.iter().map(|p| Path3::by_z(p.points.iter().map(|q| q.centre).collect())).collect();
     let mut under = Vec::new();
     for path in paths.iter().filter(|p| p.points.iter().any(|q| q.second.is_some())) {
         let a = path.points.iter().map(|q| q.contact).collect();

@@ -98,7 +98,7 @@ impl View {
 /// view so that a flat part's relief shows: its height range made at least a fifth of its width.
 fn relief(lo: &P3, hi: &P3) -> f64 {
     let (w, h) = ((hi.x - lo.x).max(hi.y - lo.y), hi.z - lo.z);
-    if !(h > 0.0) || h >= 0.2 * w {
+    if h.is_nan() || h <= 0.0 || h >= 0.2 * w {
         return 1.0;
     }
     let raw = 0.2 * w / h;
@@ -111,7 +111,10 @@ fn relief(lo: &P3, hi: &P3) -> f64 {
 /// contact lines, each in its own style).
 pub fn views(title: &str, paths: &[Path3], bar_label: &str, underlay: &[(Vec<P3>, Style)]) -> Figure {
     let all = paths.iter().flat_map(|p| p.pts.iter()).chain(underlay.iter().flat_map(|u| u.0.iter()));
-    let (mut lo, mut hi) = (P3::new(f64::INFINITY, f64::INFINITY, f64::INFINITY), P3::new(f64::NEG_INFINITY, f64::NEG_INFINITY, f64::NEG_INFINITY));
+    let (mut lo, mut hi) = (
+        P3::new(f64::INFINITY, f64::INFINITY, f64::INFINITY),
+        P3::new(f64::NEG_INFINITY, f64::NEG_INFINITY, f64::NEG_INFINITY),
+    );
     for p in all.filter(|p| p.coords.iter().all(|v| v.is_finite())) {
         lo = lo.inf(p);
         hi = hi.sup(p);
@@ -144,7 +147,9 @@ pub fn views(title: &str, paths: &[Path3], bar_label: &str, underlay: &[(Vec<P3>
     if lo.x.is_finite() {
         // Axis triad at the lowest corner, a sixth of the width long.
         let len = (hi.x - lo.x).max(hi.y - lo.y).max(hi.z - lo.z).max(1e-9) / 6.0;
-        for (d, name) in [(P3::new(len, 0.0, 0.0), "x"), (P3::new(0.0, len, 0.0), "y"), (P3::new(0.0, 0.0, len / k), "z")] {
+        for (d, name) in
+            [(P3::new(len, 0.0, 0.0), "x"), (P3::new(0.0, len, 0.0), "y"), (P3::new(0.0, 0.0, len / k), "z")]
+        {
             let a = View::Iso(k).project(&lo);
             let b = View::Iso(k).project(&(lo + d.coords));
             iso.polyline(&[a, b], Style::stroke("black", 1.2)).label(b, name, 12.0, "black");
@@ -171,10 +176,14 @@ mod tests {
         let paths: Vec<Path3> = (0..=100)
             .map(|j| {
                 let y = -50.0 + j as f64;
-                Path3::by_z((0..=1000).map(|i| {
-                    let x = -50.0 + 0.1 * i as f64;
-                    P3::new(x, y, (r * r - x * x - y * y).sqrt() - r)
-                }).collect())
+                Path3::by_z(
+                    (0..=1000)
+                        .map(|i| {
+                            let x = -50.0 + 0.1 * i as f64;
+                            P3::new(x, y, (r * r - x * x - y * y).sqrt() - r)
+                        })
+                        .collect(),
+                )
             })
             .collect();
         let zmin = paths.iter().flat_map(|p| p.values.iter()).copied().fold(f64::INFINITY, f64::min);

@@ -655,7 +655,15 @@ fn path_data(
     let arcs = |pen: &mut Pen, arc: &mut Option<Arc2>| {
         if let Some(a) = arc.take() {
             let (p, q) = (screen(a.point_at_fraction(0.0)), screen(a.point_at_fraction(1.0)));
-            let sig = [half_px(p.0), half_px(p.1), half_px(q.0), half_px(q.1), half_px(tx(a.c.x)), half_px(ty(a.c.y)), a.sweep.signum() as i64];
+            let sig = [
+                half_px(p.0),
+                half_px(p.1),
+                half_px(q.0),
+                half_px(q.1),
+                half_px(tx(a.c.x)),
+                half_px(ty(a.c.y)),
+                a.sweep.signum() as i64,
+            ];
             pen.piece(p, sig, |d| arc_commands(d, &a, tx, ty, sx, sy));
         }
     };
@@ -667,9 +675,8 @@ fn path_data(
             }
             Piece::Arc(a) => {
                 lines(&mut pen, &mut run);
-                let same_circle = |b: &Arc2| {
-                    ((b.c - a.c).norm() * sx).max((b.r - a.r).abs() * sx) < 0.05 && b.sweep * a.sweep > 0.0
-                };
+                let same_circle =
+                    |b: &Arc2| ((b.c - a.c).norm() * sx).max((b.r - a.r).abs() * sx) < 0.05 && b.sweep * a.sweep > 0.0;
                 match &mut arc {
                     Some(b) if same_circle(b) => b.sweep += a.sweep,
                     _ => {
@@ -785,7 +792,11 @@ fn colour_bar(s: &mut String, range: (f64, f64), label: &str, (x, y): (f64, f64)
             );
         }
     } else {
-        let _ = writeln!(s, r#"<rect x="{x:.1}" y="{y:.1}" width="{w}" height="{h:.1}" fill="{}"/>"#, level_colour(LEVELS / 2));
+        let _ = writeln!(
+            s,
+            r#"<rect x="{x:.1}" y="{y:.1}" width="{w}" height="{h:.1}" fill="{}"/>"#,
+            level_colour(LEVELS / 2)
+        );
     }
     let _ = writeln!(s, r##"<rect x="{x:.1}" y="{y:.1}" width="{w}" height="{h:.1}" fill="none" stroke="#888"/>"##);
     let at = |v: f64| if span > 0.0 { y + h - (v - range.0) / span * h } else { y + h / 2.0 };
