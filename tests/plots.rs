@@ -235,17 +235,33 @@ fn tool_attitude_colours_the_tip_paths_by_the_written_axis_tilt() {
     let tool = data("tool-attitude/cylinder-phi25.json");
     w.run(
         "stylus-trace",
-        &[model.to_str().unwrap(), "--mode", "scan", "-r", "12.5", "--pick", "4", "--region=-20,20,-20,20", "-o", "cl.csv"],
+        &[
+            model.to_str().unwrap(),
+            "--mode",
+            "scan",
+            "-r",
+            "12.5",
+            "--pick",
+            "4",
+            "--region=-20,20,-20,20",
+            "-o",
+            "cl.csv",
+        ],
         b"",
     )
     .ok();
-    w.run("tool-attitude", &["cl.csv", "--tool", tool.to_str().unwrap(), "--tilt", "-5", "--svg", "t.svg", "-o", "t.csv"], b"")
-        .ok();
+    w.run(
+        "tool-attitude",
+        &["cl.csv", "--tool", tool.to_str().unwrap(), "--tilt", "-5", "--svg", "t.svg", "-o", "t.csv"],
+        b"",
+    )
+    .ok();
     let seen = plot(&w, "t.svg");
     let text = w.read("t.csv");
     let mut lines = text.lines();
     let k = lines.next().unwrap().split(',').position(|c| c == "k").unwrap();
-    let tilts = lines.map(|l| l.split(',').nth(k).unwrap().parse::<f64>().unwrap().clamp(-1.0, 1.0).acos().to_degrees());
+    let tilts =
+        lines.map(|l| l.split(',').nth(k).unwrap().parse::<f64>().unwrap().clamp(-1.0, 1.0).acos().to_degrees());
     let range = tilts.fold((f64::INFINITY, f64::NEG_INFINITY), |a, v| (a.0.min(v), a.1.max(v)));
     assert!(range.0 > 0.0 && range.1 > 5.0, "tilted 5° toward the feed: {range:?}");
     // The CSV's k is the shortest exact text of the same number: the same angle.

@@ -16,10 +16,17 @@ pub fn plot(t: &Table, title: &str) -> Figure {
         .passes()
         .map(|rows| Path3 { pts: rows.iter().map(|r| r.pos).collect(), values: rows.iter().map(tilt).collect() })
         .collect();
-    let (lo, hi) = t.rows.iter().fold((P3::new(f64::INFINITY, f64::INFINITY, f64::INFINITY), P3::new(f64::NEG_INFINITY, f64::NEG_INFINITY, f64::NEG_INFINITY)), |(a, b), r| (a.inf(&r.pos), b.sup(&r.pos)));
+    let (lo, hi) = t.rows.iter().fold(
+        (
+            P3::new(f64::INFINITY, f64::INFINITY, f64::INFINITY),
+            P3::new(f64::NEG_INFINITY, f64::NEG_INFINITY, f64::NEG_INFINITY),
+        ),
+        |(a, b), r| (a.inf(&r.pos), b.sup(&r.pos)),
+    );
     let len = if lo.x.is_finite() { 0.03 * (hi - lo).norm().max(1e-6) } else { 0.0 };
     let every = t.rows.len().div_ceil(AXIS_STROKES).max(1);
     let style = Style::stroke("#555555", 0.7).named(&format!("tool axis (every {every} rows)"));
-    let axes = t.rows.iter().step_by(every).map(|r| (vec![r.pos, r.pos + r.axis * len], style.clone())).collect::<Vec<_>>();
+    let axes =
+        t.rows.iter().step_by(every).map(|r| (vec![r.pos, r.pos + r.axis * len], style.clone())).collect::<Vec<_>>();
     views(title, &paths, "tool tip: axis tilt from +z (°)", &axes)
 }
