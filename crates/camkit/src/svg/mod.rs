@@ -448,6 +448,7 @@ impl Plot {
             axes(&mut s, self, (min, max), pad, (frame_w, frame_h), &tx, &ty);
         }
         let mut drawn = Drawn::new();
+        let mut heat_drawn = false;
         for mark in &self.marks {
             match mark {
                 Mark::Path { start, pieces, closed, style } => {
@@ -479,6 +480,11 @@ impl Plot {
                     );
                 }
                 Mark::Raster(r) => raster(&mut s, r, scale.unwrap_or((0.0, 0.0)), &tx, &ty),
+                // All value-coloured paths, batched by colour, where the first one was drawn.
+                Mark::Heat { .. } if !heat_drawn => {
+                    heat(&mut s, &self.marks, scale.unwrap_or((0.0, 0.0)), &tx, &ty);
+                    heat_drawn = true;
+                }
                 Mark::Heat { .. } => {}
                 Mark::Label { at, text, size_px, colour } => {
                     let _ = writeln!(
@@ -492,7 +498,6 @@ impl Plot {
             }
         }
         if let Some(range) = scale {
-            heat(&mut s, &self.marks, range, &tx, &ty);
             colour_bar(&mut s, range, &self.bar_label, (pad.0 + frame_w + 24.0, pad.3), frame_h);
         }
         for (k, style) in legend.into_iter().enumerate() {
