@@ -13,18 +13,19 @@ use std::f64::consts::FRAC_PI_2;
 pub enum Kind {
     /// G0.
     Rapid,
-    /// A feed move going down more steeply than [`ENTRY_SLOPE`] after a rapid or another entry:
-    /// a plunge or a leg of a ramp.
+    /// A feed move going down more steeply than [`ENTRY_SLOPE`] right after a rapid, or after an
+    /// entry at the same feed: a plunge or a leg of a ramp.
     Entry,
-    /// An arc next to an entry or a rapid: a lead in or out.
+    /// An arc next to an entry, a rapid or a link: a lead in or out.
     Lead,
-    /// A feed move going up more steeply than [`ENTRY_SLOPE`]: a retract or link at feed.
+    /// A feed move going up more steeply than [`ENTRY_SLOPE`] right before a rapid (or the end),
+    /// or before a link at the same feed: a retract at feed.
     Link,
-    /// Every other feed move.
+    /// Every other feed move (a cut on a 3-D surface may go up and down).
     Cut,
 }
 
-/// Slope (rise over run) beyond which a feed move counts as an entry or a link: 1°.
+/// Slope (rise over run) beyond which a feed move may be an entry or a link: 1°.
 pub const ENTRY_SLOPE: f64 = 0.017_455;
 
 impl Kind {
@@ -33,7 +34,7 @@ impl Kind {
             Kind::Rapid => Style::stroke("#888888", 0.8).dashed("5 4").named("rapid (G0)"),
             Kind::Entry => Style::stroke("#d62728", 1.4).named("plunge or ramp"),
             Kind::Lead => Style::stroke("#2ca02c", 1.4).named("lead arc"),
-            Kind::Link => Style::stroke("#ff7f0e", 1.2).named("retract or link at feed"),
+            Kind::Link => Style::stroke("#ff7f0e", 1.2).named("retract at feed"),
             Kind::Cut => Style::stroke("#1f77b4", 1.0).named("cut"),
         }
     }
@@ -49,25 +50,52 @@ struct Block {
 
 /// The kinds of the blocks from each pose to the next (`None` where either is unknown).
 pub fn kinds(poses: &[Option<NcPose>], r: &Reading) -> Vec<Option<Kind>> {
+    let n = poses.len();
     let tip = |p: &NcPose| r.at(&p.joints).0;
-    let mut out: Vec<Option<Kind>> = vec![None; poses.len()];
-    for k in 1..poses.len() {
-        let (Some(a), Some(b)) = (&poses[k - 1], &poses[k]) else { continue };
-        let d = tip(b) - tip(a);
-        let run = d.xy().norm();
-        let prev = out[k - 1];
+    let feed = |k: usize| poses[k].as_ref().and_then(|p| p.feed);
+    // The block's climb: -1 steeply down, 1 steeply up, 0 otherwise (or unknown).
+    let climb = |k: usize| match (&poses[k - 1], &poses[k]) {
+        (Some(a), Some(b)) => {
+            let d = tip(b) - tip(a);
+            let run = d.xy().norm();
+            if d.z < -ENTRY_SLOPE * run && d.z < 0.0 {
+                -1
+            } else if d.z > ENTRY_SLOPE * run && d.z > 0.0 {
+                1
+            } else {
+                0
+            }
+        }
+        _ => 0,
+    };
+    let mut out: Vec<Option<Kind>> = vec![None; n];
+    for k in 1..n {
+        let (Some(_), Some(b)) = (&poses[k - 1], &poses[k]) else { continue };
+        let entry_before = match out[k - 1] {
+            None | Some(Kind::Rapid) => true,
+            Some(Kind::Entry) => feed(k) == feed(k - 1),
+            _ => false,
+        };
         out[k] = Some(if b.rapid {
             Kind::Rapid
-        } else if d.z < -ENTRY_SLOPE * run && matches!(prev, None | Some(Kind::Rapid | Kind::Entry)) {
+        } else if climb(k) < 0 && entry_before {
             Kind::Entry
-        } else if d.z > ENTRY_SLOPE * run && d.z > 0.0 {
-            Kind::Link
         } else {
             Kind::Cut
         });
     }
+    for k in (1..n).rev() {
+        let link_after = match out.get(k + 1) {
+            None | Some(None | Some(Kind::Rapid)) => true,
+            Some(Some(Kind::Link)) => feed(k) == feed(k + 1),
+            _ => false,
+        };
+        if out[k] == Some(Kind::Cut) && climb(k) > 0 && link_after {
+            out[k] = Some(Kind::Link);
+        }
+    }
     // Arcs next to an entry, a rapid or a link are leads.
-    for k in 1..poses.len() {
+    for k in 1..n {
         let is_arc = poses[k].as_ref().is_some_and(|p| p.arc.is_some());
         let beside = |j: usize| matches!(out.get(j), Some(Some(Kind::Rapid | Kind::Entry | Kind::Link)));
         if is_arc && out[k] == Some(Kind::Cut) && (beside(k - 1) || beside(k + 1)) {
