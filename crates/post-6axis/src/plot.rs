@@ -14,7 +14,7 @@ pub enum Kind {
     /// G0.
     Rapid,
     /// A feed move going down more steeply than [`ENTRY_SLOPE`] right after a rapid, or after an
-    /// entry at the same feed: a plunge or a leg of a ramp.
+    /// entry at the same feed or along a helix: a plunge or a leg of a ramp.
     Entry,
     /// An arc next to an entry, a rapid or a link: a lead in or out.
     Lead,
@@ -73,7 +73,8 @@ pub fn kinds(poses: &[Option<NcPose>], r: &Reading) -> Vec<Option<Kind>> {
         let (Some(_), Some(b)) = (&poses[k - 1], &poses[k]) else { continue };
         let entry_before = match out[k - 1] {
             None | Some(Kind::Rapid) => true,
-            Some(Kind::Entry) => feed(k) == feed(k - 1),
+            // A helix going down goes on ramping whatever its feed.
+            Some(Kind::Entry) => feed(k) == feed(k - 1) || b.arc.is_some(),
             _ => false,
         };
         out[k] = Some(if b.rapid {
