@@ -96,7 +96,7 @@ struct Args {
     #[arg(long, value_name = "N")]
     decimals: Option<u32>,
     /// Write an SVG of the tool tip paths: isometric, top and side views coloured by the tool
-    /// axis's tilt from +z (degrees), the axis drawn at evenly spaced rows.
+    /// axis's tilt from +z (degrees; by z for one fixed axis), the axis drawn at evenly spaced rows.
     #[arg(long, value_name = "FILE")]
     svg: Option<PathBuf>,
 }

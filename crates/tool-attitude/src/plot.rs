@@ -9,12 +9,17 @@ use camkit::table::Table;
 /// Tool-axis strokes drawn over the whole table (about; every n-th row).
 const AXIS_STROKES: usize = 150;
 
-/// The 3-D views of `t`'s tip paths, one per pass, coloured by the axis tilt (degrees).
+/// The 3-D views of `t`'s tip paths, one per pass, coloured by the axis tilt (degrees), or by
+/// the tip's z when every row has the same axis (a fixed-axis tool).
 pub fn plot(t: &Table, title: &str) -> Figure {
     let tilt = |r: &camkit::table::Row| r.axis.z.clamp(-1.0, 1.0).acos().to_degrees();
+    let fixed = t.rows.windows(2).all(|w| w[0].axis == w[1].axis);
     let paths: Vec<Path3> = t
         .passes()
-        .map(|rows| Path3 { pts: rows.iter().map(|r| r.pos).collect(), values: rows.iter().map(tilt).collect() })
+        .map(|rows| {
+            let pts = rows.iter().map(|r| r.pos).collect();
+            if fixed { Path3::by_z(pts) } else { Path3 { pts, values: rows.iter().map(tilt).collect() } }
+        })
         .collect();
     let (lo, hi) = t.rows.iter().fold(
         (
@@ -28,5 +33,6 @@ pub fn plot(t: &Table, title: &str) -> Figure {
     let style = Style::stroke("#555555", 0.7).named(&format!("tool axis (every {every} rows)"));
     let axes =
         t.rows.iter().step_by(every).map(|r| (vec![r.pos, r.pos + r.axis * len], style.clone())).collect::<Vec<_>>();
-    views(title, &paths, "tool tip: axis tilt from +z (°)", &axes)
+    let bar = if fixed { "tool tip z (mm), fixed axis" } else { "tool tip: axis tilt from +z (°)" };
+    views(title, &paths, bar, &axes)
 }
