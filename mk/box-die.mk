@@ -30,7 +30,8 @@ $(BOX_DIE)/program.csv $(BOX_DIE)/report.json $(BOX_DIE)/trochoids.svg $(BOX_DIE
 
 # The trochoids-first program for the 3-axis machine: every chain linked (retract to the safe
 # height, traverse, rapid to 1 mm over what the earlier cuts left, 3° ramp along the pass), the
-# written program checked against the material left and the cavity's walls before delivery.
-$(BOX_DIE)/program.ngc $(BOX_DIE)/program.json &: $(BOX_DIE)/program.csv $(BOX_DIE_SETUP) $(BOX_DIE_MACHINE) $(RELEASE)/post-6axis
+# written program checked against the material left and the cavity's walls before delivery;
+# program.svg is the program read back (rapids, ramps, leads, cuts; arcs as arcs).
+$(BOX_DIE)/program.ngc $(BOX_DIE)/program.json $(BOX_DIE)/program.svg &: $(BOX_DIE)/program.csv $(BOX_DIE_SETUP) $(BOX_DIE_MACHINE) $(RELEASE)/post-6axis
 	$(RELEASE)/post-6axis $< --machine $(BOX_DIE_MACHINE) --setup $(BOX_DIE_SETUP) \
-	  --report $(BOX_DIE)/program.json -o $(BOX_DIE)/program.ngc
+	  --svg $(BOX_DIE)/program.svg --report $(BOX_DIE)/program.json -o $(BOX_DIE)/program.ngc

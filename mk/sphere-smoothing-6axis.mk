@@ -19,10 +19,10 @@ SPHERE_SMOOTHING_SETUP ?= data/jobs/sphere-smoothing.json
 
 demo-sphere-smoothing: $(SPHERE_SMOOTHING_6AXIS)/tool.csv $(SPHERE_SMOOTHING_6AXIS)/part.ngc
 
-$(SPHERE_SMOOTHING_6AXIS)/tool.csv $(SPHERE_SMOOTHING_6AXIS)/tool.json &: $(SPHERE_SMOOTHING_6AXIS)/cl.csv \
+$(SPHERE_SMOOTHING_6AXIS)/tool.csv $(SPHERE_SMOOTHING_6AXIS)/tool.json $(SPHERE_SMOOTHING_6AXIS)/tool.svg &: $(SPHERE_SMOOTHING_6AXIS)/cl.csv \
   $(SPHERE_SMOOTHING_6AXIS)/model.json $(SPHERE_SMOOTHING_TOOL) $(RELEASE)/tool-attitude
 	$(RELEASE)/tool-attitude $< --tool $(SPHERE_SMOOTHING_TOOL) --tilt $(SPHERE_SMOOTHING_TILT) \
-	  --model $(SPHERE_SMOOTHING_6AXIS)/model.json \
+	  --model $(SPHERE_SMOOTHING_6AXIS)/model.json --svg $(SPHERE_SMOOTHING_6AXIS)/tool.svg \
 	  --report $(SPHERE_SMOOTHING_6AXIS)/tool.json -o $(SPHERE_SMOOTHING_6AXIS)/tool.csv
 
 $(SPHERE_SMOOTHING_6AXIS)/part.ngc $(SPHERE_SMOOTHING_6AXIS)/part.json &: $(SPHERE_SMOOTHING_6AXIS)/tool.csv \

@@ -266,7 +266,7 @@ fn fit_blocks<R: BufRead>(
         stats.points += pts.len();
         stats.add_pieces(pieces);
         if keep_runs {
-            runs.push(FittedRun { pts: pts.clone(), pieces: pieces.to_vec() });
+            runs.push(FittedRun { pts: pts.clone(), pieces: pieces.to_vec(), extrusion: e_rate(&head) });
         }
     }
     flush(&mut w, out)?;

@@ -131,6 +131,9 @@ pub struct FittedRun {
     pub pts: Vec<P3>,
     /// Its pieces.
     pub pieces: Vec<fit::Piece>,
+    /// Extrusion (E) per mm of its blocks, for G-code that carries E words; `None` for toolpath
+    /// rows and blocks without E (a printer's travel).
+    pub extrusion: Option<f64>,
 }
 
 /// Appends `p` to `pts` unless it repeats the last point; returns false if it was dropped.

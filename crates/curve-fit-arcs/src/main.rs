@@ -86,7 +86,9 @@ struct Args {
     /// joints anywhere (report key moves_lower_bound; slower than the fit itself).
     #[arg(long)]
     lower_bound: bool,
-    /// Write an SVG of the input points and the fitted lines and arcs.
+    /// Write an SVG of the input points and the fitted lines and arcs; a layered program (three
+    /// heights or more, e.g. a print) as isometric, top and side views coloured by height, travel
+    /// dashed apart from extrusion.
     #[arg(long, value_name = "FILE")]
     svg: Option<PathBuf>,
 }
@@ -271,7 +273,7 @@ fn finish(
     if let Some(path) = &args.svg {
         let plane = opts.planes[0];
         let title = format!("{}: {} moves → {} (tol {} mm)", name, stats.input_moves, stats.output_moves, opts.tol);
-        write_atomic(path, plot::plot(runs, plane, &title).to_svg(1000.0).as_bytes())?;
+        write_atomic(path, plot::svg(runs, plane, &title, 1200.0).as_bytes())?;
     }
     if let Some(path) = &args.io.report {
         let mut r = report(stats, opts, seconds, bytes_in, bytes_out);

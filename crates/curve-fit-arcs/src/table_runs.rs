@@ -101,7 +101,7 @@ pub fn fit_table(
         }
         stats.points += pts.len();
         stats.add_pieces(&pieces);
-        runs.push(FittedRun { pts, pieces });
+        runs.push(FittedRun { pts, pieces, extrusion: None });
         // The run's last row starts the next one.
         k = end;
     }

@@ -141,7 +141,8 @@ struct Args {
     /// written rows keep R + allowance and the threshold (the report is the written program's).
     #[arg(long, value_name = "N")]
     decimals: Option<u32>,
-    /// SVG of the written program: contours, medial axis, danger regions, passes coloured by engagement.
+    /// SVG of the written program: contours, medial axis, danger regions, passes coloured by
+    /// engagement on a colour bar in degrees.
     #[arg(long, value_name = "FILE")]
     svg: Option<PathBuf>,
     /// SVG of the other program (offset-only when writing trochoids, and the reverse).

@@ -5,45 +5,33 @@ use crate::{Analysed, Plan};
 use camkit::contour::Seg;
 use camkit::contour::region::Region;
 use camkit::geom::P2;
-use camkit::svg::{Aspect, Piece, Plot, Style, ramp};
+use camkit::svg::{Aspect, Piece, Plot, Style};
 
-/// Engagement colour bands (degrees per band) of the plot.
-const BAND: f64 = 15.0;
-
-fn colour(deg: f64) -> String {
-    let (r, g, b) = ramp((deg / BAND).floor() * BAND / 180.0);
-    format!("#{r:02x}{g:02x}{b:02x}")
-}
-
-/// The moves of `a` as polylines through their samples, coloured by engagement band.
+/// The moves of `a` as polylines through their samples, coloured by engagement on the colour
+/// bar (degrees) from 0 to the largest engagement of cutting moves and links; entries (plunges,
+/// ramps) beyond it are drawn in the top colour.
 fn coloured(p: &mut Plot, a: &Analysed, width: f64) {
-    let mut run: Vec<P2> = Vec::new();
-    let mut band = f64::NAN;
+    let (mut pts, mut values): (Vec<P2>, Vec<f64>) = (Vec::new(), Vec::new());
     let mut last_move = usize::MAX;
     for (&(i, t), &e) in a.samples.iter().zip(&a.engagement) {
         let m = &a.program.moves[i];
-        let q = m.seg.point_at(t);
-        let b = (e / BAND).floor();
         let joined = i == last_move || (last_move.checked_add(1) == Some(i) && !m.retract_before);
-        if !joined || b != band {
-            if run.len() > 1 {
-                p.polyline(&run, Style::stroke(&colour(band * BAND), width));
-            }
-            let from = if joined { run.last().copied() } else { None };
-            run = vec![from.unwrap_or_else(|| m.seg.point_at(0.0))];
-            band = b;
+        if !joined {
+            p.heat(&pts, &values, width);
+            (pts, values) = (vec![m.seg.point_at(0.0)], vec![e]);
         }
-        run.push(q);
+        pts.push(m.seg.point_at(t));
+        values.push(e);
         last_move = i;
     }
-    if run.len() > 1 {
-        p.polyline(&run, Style::stroke(&colour(band * BAND), width));
-    }
+    p.heat(&pts, &values, width);
+    p.colour_bar("path: engagement (°); entries above the top in its colour")
+        .colour_range(0.0, a.max_cutting.max(a.max_link));
 }
 
 /// The contours of `regions` in black.
 fn contours(p: &mut Plot, regions: &[Region]) {
-    outlines(p, regions, &Style::stroke("black", 1.6));
+    outlines(p, regions, &Style::stroke("black", 1.6).named("contour"));
 }
 
 /// The loops of `regions` drawn with `style`.
@@ -69,8 +57,6 @@ pub fn given_plot(title: &str, regions: &[Region], a: &Analysed) -> Plot {
     let mut p = Plot::new(title, Aspect::Equal);
     contours(&mut p, regions);
     coloured(&mut p, a, 0.8);
-    p.legend("contour", Style::stroke("black", 1.6))
-        .legend("path: engagement 0° (dark) to 180° (yellow), 15° bands", Style::stroke(&colour(90.0), 0.8));
     p
 }
 
@@ -80,16 +66,18 @@ pub fn given_plot(title: &str, regions: &[Region], a: &Analysed) -> Plot {
 pub fn plan_plot(title: &str, plan: &Plan, trochoidal: bool) -> Plot {
     let mut p = Plot::new(title, Aspect::Equal);
     let opened = Style::stroke("#555555", 1.0).dashed("6 3");
-    let uncut = Style::stroke("#e377c2", 4.0);
+    let uncut = Style::stroke("#e377c2", 4.0).named("left uncut (tool cannot reach it under the threshold)");
     match &plan.uncut {
         Some(u) => {
             contours(&mut p, &u.original);
-            outlines(&mut p, &plan.regions, &opened);
+            outlines(
+                &mut p,
+                &plan.regions,
+                &opened.named(&format!("opened contour ({:.3} mm disk rolled inside)", u.rho)),
+            );
             for st in &u.stretches {
                 p.polyline(&st.points, uncut.clone());
             }
-            p.legend(&format!("opened contour ({:.3} mm disk rolled inside)", u.rho), opened)
-                .legend("left uncut (tool cannot reach it under the threshold)", uncut);
         }
         None => contours(&mut p, &plan.regions),
     }
@@ -97,24 +85,22 @@ pub fn plan_plot(title: &str, plan: &Plan, trochoidal: bool) -> Plot {
     coloured(&mut p, a, 0.8);
     for m in &plan.medial {
         for e in &m.edges {
-            p.polyline(&e.points, Style::stroke("#7f7f7f", 1.0).dashed("4 2"));
+            p.polyline(&e.points, Style::stroke("#7f7f7f", 1.0).dashed("4 2").named("medial axis"));
         }
     }
     for d in &plan.danger {
-        p.polyline(d, Style::stroke("#d62728", 3.0));
+        p.polyline(d, Style::stroke("#d62728", 3.0).named("danger (engagement over threshold)"));
     }
     if trochoidal {
         for d in &plan.uncleared {
-            p.polyline(d, Style::stroke("#ff7f0e", 3.0));
+            p.polyline(d, Style::stroke("#ff7f0e", 3.0).named("danger where no trochoid fits"));
         }
         for r in &plan.rests {
-            p.polygon(&r.outline(24), Style::fill("#2ca02c", 0.7));
+            p.polygon(
+                &r.outline(24),
+                Style::fill("#2ca02c", 0.7).named("corner rest left to finishing (rounded wall pass)"),
+            );
         }
-        p.legend("corner rest left to finishing (rounded wall pass)", Style::fill("#2ca02c", 0.7));
     }
-    p.legend("contour", Style::stroke("black", 1.6))
-        .legend("medial axis", Style::stroke("#7f7f7f", 1.0).dashed("4 2"))
-        .legend("danger (engagement over threshold)", Style::stroke("#d62728", 3.0))
-        .legend("passes: engagement 0° (dark) to 180° (yellow), 15° bands", Style::stroke(&colour(90.0), 0.8));
     p
 }

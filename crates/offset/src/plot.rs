@@ -12,6 +12,8 @@ const INPUT: &str = "black";
 const PASS: &str = "#1f77b4";
 /// Colour of gouge regions.
 const GOUGE: &str = "#d62728";
+/// Most gouge slices drawn (more shade the same region and only add bytes).
+const GOUGE_SLICES: usize = 300;
 
 /// The pieces of a contour for the plot.
 fn pieces(segs: impl Iterator<Item = Seg>) -> Vec<Piece> {
@@ -33,14 +35,13 @@ pub fn contour(plot: &mut Plot, c: &Contour, style: Style) {
 pub fn passes(title: &str, input: &[Contour], output: &[Contour]) -> Plot {
     let mut p = Plot::new(title, Aspect::Equal);
     for c in input {
-        contour(&mut p, c, Style::stroke(INPUT, 1.6));
+        contour(&mut p, c, Style::stroke(INPUT, 1.6).named("input contour"));
     }
     for c in output {
-        contour(&mut p, c, Style::stroke(PASS, 1.2));
+        contour(&mut p, c, Style::stroke(PASS, 1.2).named("offset (tool centre)"));
     }
     let starts: Vec<P2> = output.iter().filter_map(|c| c.vertices.first().map(|v| v.p)).collect();
-    p.dots(&starts, 2.5, Style::fill(PASS, 1.0));
-    p.legend("input contour", Style::stroke(INPUT, 1.6)).legend("offset (tool centre)", Style::stroke(PASS, 1.2));
+    p.dots(&starts, 2.5, Style::fill(PASS, 1.0).named("pass start"));
     p
 }
 
@@ -52,8 +53,10 @@ pub fn profile(title: &str, profile: &[Seg], tool: Tool, r: f64, tip: &[Seg], un
     let (u0, u1) = (profile[0].start().x, profile[profile.len() - 1].end().x);
     if tool == Tool::Square {
         // Gouge: the region between the bottom and the profile above it, as thin slices.
+        // At most GOUGE_SLICES slices, evenly spaced.
+        let every = unoffset.u.len().div_ceil(GOUGE_SLICES).max(1);
         for (i, &u) in unoffset.u.iter().enumerate() {
-            if unoffset.gouge[i] <= 0.0 || i % 2 == 1 {
+            if unoffset.gouge[i] <= 0.0 || i % every != 0 {
                 continue;
             }
             let f = profile_height(profile, u);
@@ -67,12 +70,15 @@ pub fn profile(title: &str, profile: &[Seg], tool: Tool, r: f64, tip: &[Seg], un
                 .collect();
             poly.push(P2::new(b, f));
             poly.push(P2::new(a, f));
-            p.polygon(&poly, Style::fill(GOUGE, 0.05));
+            p.polygon(&poly, Style::fill(GOUGE, 0.15).named("gouge of the unoffset path (bottom below the profile)"));
         }
         let mut u = u0;
         while u <= u1 + 1e-9 {
             let f = profile_height(profile, u);
-            p.polyline(&[P2::new(u - r, f), P2::new(u + r, f)], Style::stroke("#777", 1.0));
+            p.polyline(
+                &[P2::new(u - r, f), P2::new(u + r, f)],
+                Style::stroke("#777", 1.0).named("square end mill bottom on the unoffset path, every 1 mm"),
+            );
             u += 1.0;
         }
         for (a, b) in &unoffset.clear {
@@ -82,22 +88,23 @@ pub fn profile(title: &str, profile: &[Seg], tool: Tool, r: f64, tip: &[Seg], un
     } else {
         let mut u = u0;
         while u <= u1 + 1e-9 {
-            p.circle(P2::new(u, profile_height(profile, u)), r, Style::stroke("#999", 0.6));
+            p.circle(
+                P2::new(u, profile_height(profile, u)),
+                r,
+                Style::stroke("#999", 0.6).named("ball on the unoffset path, every 0.5 mm"),
+            );
             u += 0.5;
         }
     }
     let first = profile[0].start();
-    p.path(first, pieces(profile.iter().copied()), false, Style::stroke(INPUT, 1.8));
+    p.path(first, pieces(profile.iter().copied()), false, Style::stroke(INPUT, 1.8).named("profile"));
     if let Some(s) = tip.first() {
-        p.path(s.start(), pieces(tip.iter().copied()), false, Style::stroke(PASS, 1.8));
-    }
-    p.legend("profile", Style::stroke(INPUT, 1.8))
-        .legend("tip path, offset (never cuts into the profile)", Style::stroke(PASS, 1.8));
-    if tool == Tool::Square {
-        p.legend("square end mill bottom on the unoffset path, every 1 mm", Style::stroke("#777", 1.0))
-            .legend("gouge of the unoffset path (bottom below the profile)", Style::fill(GOUGE, 0.5));
-    } else {
-        p.legend("ball on the unoffset path, every 0.5 mm", Style::stroke("#999", 0.6));
+        p.path(
+            s.start(),
+            pieces(tip.iter().copied()),
+            false,
+            Style::stroke(PASS, 1.8).named("tip path, offset (never cuts into the profile)"),
+        );
     }
     p
 }
@@ -106,11 +113,10 @@ pub fn profile(title: &str, profile: &[Seg], tool: Tool, r: f64, tip: &[Seg], un
 pub fn space(title: &str, input: &[Vec<P2>], output: &[Vec<P2>]) -> Plot {
     let mut p = Plot::new(title, Aspect::Equal);
     for c in input {
-        p.polyline(c, Style::stroke(INPUT, 1.4));
+        p.polyline(c, Style::stroke(INPUT, 1.4).named("contour (seen from +z)"));
     }
     for c in output {
-        p.polyline(c, Style::stroke(PASS, 1.2));
+        p.polyline(c, Style::stroke(PASS, 1.2).named("tool tip"));
     }
-    p.legend("contour (seen from +z)", Style::stroke(INPUT, 1.4)).legend("tool tip", Style::stroke(PASS, 1.2));
     p
 }

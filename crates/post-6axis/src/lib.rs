@@ -12,6 +12,7 @@ pub mod collision;
 pub mod link;
 pub mod nc;
 pub mod plan;
+pub mod plot;
 pub mod readback;
 
 use camkit::doc::machine::Machine;

@@ -9,12 +9,13 @@ use camkit::doc::machine::Machine;
 use camkit::doc::setup::{Job, Part};
 use camkit::error::{Error, Location, Result};
 use camkit::gcode::read_axes;
-use camkit::io::{Input, Output};
+use camkit::io::{Input, Output, write_atomic};
 use camkit::kinematics::Chain;
 use camkit::report::Report;
 use camkit::table::{self, Col, WriteOptions};
 use clap::Parser;
-use post_6axis::{Settings, cl_rows, collision, judge, link, post, readback};
+use post_6axis::{Settings, cl_rows, collision, judge, link, plot, post, readback};
+use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Instant;
 
@@ -76,6 +77,11 @@ struct Args {
     /// the first block that comes too near the material or the part. INPUT is not read.
     #[arg(long, value_name = "NC", requires = "setup", conflicts_with_all = ["verify", "reverse"])]
     check: Option<String>,
+    /// Write an SVG of the program (the one written, or with --reverse the one read): the tool
+    /// tip of every block read back, top view and side views, rapids dashed, plunges/ramps,
+    /// leads, links at feed and cuts in their own colours, G2/G3 as arcs in their plane's view.
+    #[arg(long, value_name = "FILE", conflicts_with_all = ["verify", "check"])]
+    svg: Option<PathBuf>,
     /// Write the program even when the collision check finds a rapid into material or a move
     /// nearer the part than allowed (a warning; the report names them).
     #[arg(long, requires = "setup")]
@@ -191,6 +197,10 @@ fn run(args: Args) -> Result<()> {
             return Err(Error::input("no motion blocks in the program").at(Location::file(&input.name)));
         }
         report.set("blocks", program.moves.len()).set("rows", t.rows.len());
+        if let Some(path) = &args.svg {
+            let title = format!("{}: {} blocks on {}", input.name, program.moves.len(), machine.name);
+            write_atomic(path, plot::plot(&title, &poses, &reading).to_svg(1200.0).as_bytes())?;
+        }
         table::write(&mut out, &t, &WriteOptions::default())?;
         return finish(out, &args, report);
     }
@@ -257,6 +267,14 @@ fn run(args: Args) -> Result<()> {
     }
     if let Some(j) = &job {
         collide(&posted.text, &machine, &chain, j, (walls.as_ref(), solid_ref), &args, &mut report)?;
+    }
+    if let Some(path) = &args.svg {
+        let text = std::str::from_utf8(&posted.text).map_err(|_| Error::runtime("the written program is not UTF-8"))?;
+        let program = read_axes("written program", text)?;
+        let reading = readback::Reading::new(&machine, &chain);
+        let poses = readback::poses(&program, &reading);
+        let title = format!("{} posted for {}: {} blocks", input.name, machine.name, program.moves.len());
+        write_atomic(path, plot::plot(&title, &poses, &reading).to_svg(1200.0).as_bytes())?;
     }
     out.buf = posted.text;
     if posted.plan.singular_rows > 0 {

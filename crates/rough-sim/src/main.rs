@@ -138,7 +138,8 @@ struct PatchArgs {
     /// Patch size across and along as mm (overrides --picks/--teeth), centred on pass 0.
     #[arg(long, value_name = "MM")]
     size: Option<f64>,
-    /// Write an SVG colour map of the heights.
+    /// Write an SVG colour map of the heights in mm (colour bar in mm; roughness figures in µm in
+    /// the title).
     #[arg(long, value_name = "FILE")]
     svg: Option<PathBuf>,
     /// Write the cross-feed profile through the highest point and the feed profile through it (CSV).
@@ -237,7 +238,7 @@ struct ZmapArgs {
     /// Largest work, in exact edge evaluations (about 1 µs each); larger runs are refused.
     #[arg(long, default_value_t = budget::DEFAULT_WORK, value_name = "N")]
     max_work: f64,
-    /// Write an SVG colour map.
+    /// Write an SVG colour map of the z-map in mm (colour bar in mm).
     #[arg(long, value_name = "FILE")]
     svg: Option<PathBuf>,
 }
@@ -393,7 +394,10 @@ fn patch(a: PatchArgs) -> Result<()> {
             "r {} mm, f {} mm, fz {:.3} mm, ζ {}°",
             cond.cutter.radius, cond.pick, cond.feed_per_tooth, a.cond.tilt
         );
-        write_atomic(path, render::colour_map(&map, &title, 0.0).as_bytes())?;
+        write_atomic(
+            path,
+            render::colour_map(&map, &title, "h: height above the nominal surface (mm)", Some(&figs.map)).as_bytes(),
+        )?;
     }
     if let Some(path) = &a.profiles {
         write_atomic(path, &profiles_csv(&map, figs.map.max_at))?;
@@ -604,7 +608,7 @@ fn zmap_cmd(a: ZmapArgs) -> Result<()> {
     let (lo, hi) = cut.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |a, &v| (a.0.min(v), a.1.max(v)));
     let f = rough_sim::figures::figures(&map, f64::INFINITY, None, true);
     if let Some(path) = &a.svg {
-        write_atomic(path, render::colour_map(&map, &format!("{}: z-map", input.name), lo).as_bytes())?;
+        write_atomic(path, render::colour_map(&map, &format!("{}: z-map", input.name), "z (mm)", None).as_bytes())?;
     }
     if let Some(path) = &a.io.report {
         let mut r = Report::new("rough-sim");

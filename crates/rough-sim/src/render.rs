@@ -1,6 +1,7 @@
 //! Height maps and figures written out: CSV (x, y, height), an SVG colour map, and profile and
 //! sweep plots.
 
+use crate::figures::Figures;
 use crate::patch::HeightMap;
 use camkit::geom::P2;
 use camkit::svg::{Aspect, Plot, Raster, Style};
@@ -28,40 +29,45 @@ pub fn csv(map: &HeightMap, name: &str) -> Vec<u8> {
     out.into_bytes()
 }
 
-/// An SVG colour map of the heights (in µm above `zero`), sampled down to at most
-/// [`MAP_CELLS`] a side by taking each cell's highest node (peaks stay visible).
-pub fn colour_map(map: &HeightMap, title: &str, zero: f64) -> String {
+/// An SVG colour map of the heights in mm (absolute, as in the CSV), sampled down to at most
+/// [`MAP_CELLS`] a side by taking each cell's highest node (peaks stay visible), on a colour bar
+/// labelled `bar` (with its unit); the roughness figures, if given, in µm in the title.
+pub fn colour_map(map: &HeightMap, title: &str, bar: &str, figures: Option<&Figures>) -> String {
     let g = &map.grid;
     let k = g.nx.max(g.ny).div_ceil(MAP_CELLS).max(1);
     let (nx, ny) = (g.nx.div_ceil(k), g.ny.div_ceil(k));
     let mut values = vec![f64::NAN; nx * ny];
     for i in 0..g.nx {
         for j in 0..g.ny {
-            let v = (map.at(i, j) - zero) * 1e3;
+            let v = map.at(i, j);
             let cell = &mut values[(j / k) * nx + i / k];
             if v.is_finite() && !(cell.is_finite() && *cell >= v) {
                 *cell = v;
             }
         }
     }
-    let (lo, hi) = values
+    // The colour bar spans every node, not only the cells' highest ones.
+    let (lo, hi) = map
+        .h
         .iter()
         .filter(|v| v.is_finite())
         .fold((f64::INFINITY, f64::NEG_INFINITY), |a, &v| (a.0.min(v), a.1.max(v)));
-    let range = if lo.is_finite() { (lo, hi) } else { (0.0, 1.0) };
     let cell = (g.step * k as f64, g.step * k as f64);
-    let mut p = Plot::new(&format!("{title} (height {:.2} to {:.2} µm)", range.0, range.1), Aspect::Equal);
-    p.labels("x (mm)", "y (mm)");
+    let title = match figures {
+        Some(f) => format!(
+            "{title}: highest point {:.2} µm, Rz {:.2} µm across the feed, {:.2} µm along it",
+            f.max_height * 1e3,
+            f.cross_rz * 1e3,
+            f.feed_rz * 1e3
+        ),
+        None => title.to_string(),
+    };
+    let mut p = Plot::new(&title, Aspect::Equal);
+    p.labels("x (mm)", "y (mm)").colour_bar(bar);
     let origin = P2::new(g.x0 - cell.0 / 2.0, g.y0 - cell.1 / 2.0);
-    p.raster(Raster { origin, cell, nx, ny, values, range });
-    // Colour bar: eleven swatches from low to high.
-    for s in 0..=10 {
-        let t = s as f64 / 10.0;
-        let (r, gg, b) = camkit::svg::ramp(t);
-        p.legend(
-            &format!("{:.2} µm", range.0 + t * (range.1 - range.0)),
-            Style::fill(&format!("#{r:02x}{gg:02x}{b:02x}"), 1.0),
-        );
+    p.raster(Raster { origin, cell, nx, ny, values });
+    if lo.is_finite() {
+        p.colour_range(lo, hi);
     }
     p.to_svg(900.0)
 }
@@ -88,14 +94,13 @@ pub fn chart(title: &str, x_label: &str, y_label: &str, series: &[Series]) -> St
     for s in series {
         let pts: Vec<P2> = s.pts.iter().filter(|q| q.1.is_finite()).map(|q| P2::new(q.0, q.1)).collect();
         let colour = COLOURS[s.colour % COLOURS.len()];
-        let mut style = Style::stroke(colour, if s.dashed { 1.2 } else { 1.8 });
+        let mut style = Style::stroke(colour, if s.dashed { 1.2 } else { 1.8 }).named(&s.name);
         if s.dashed {
             style = style.dashed("6 4");
         } else {
             p.dots(&pts, 2.5, Style::fill(colour, 1.0));
         }
-        p.polyline(&pts, style.clone());
-        p.legend(&s.name, style);
+        p.polyline(&pts, style);
     }
     p.to_svg(800.0)
 }

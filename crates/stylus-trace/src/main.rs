@@ -92,7 +92,8 @@ struct Args {
     /// Fixed decimals for positions (default: exact shortest round-trip numbers).
     #[arg(long, value_name = "N")]
     decimals: Option<u32>,
-    /// Write an SVG (top view) of the traced lines.
+    /// Write an SVG of the traced stylus centres: isometric, top and side views coloured by height
+    /// (thinned to the picture's resolution).
     #[arg(long, value_name = "FILE")]
     svg: Option<PathBuf>,
     /// Worker threads (default: all cores, at most 256); the output is the same for any number.
@@ -351,7 +352,7 @@ fn run(args: Args) -> Result<()> {
             paths.len(),
             verified.points
         );
-        write_atomic(path, output::plot(&paths, &title).to_svg(1000.0).as_bytes())?;
+        write_atomic(path, output::plot(&paths, &title).to_svg(1200.0).as_bytes())?;
     }
     if let Some(path) = &args.io.report {
         let iterations: Vec<u32> = paths.iter().flat_map(|p| p.points.iter().map(|q| q.iterations)).collect();

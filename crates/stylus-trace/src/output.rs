@@ -1,9 +1,9 @@
 //! The traced paths as the toolpath table and as a plot.
 
 use crate::TracedPath;
-use camkit::geom::P2;
 use camkit::model::Model;
-use camkit::svg::{Aspect, Plot, Style};
+use camkit::svg::Style;
+use camkit::svg::figure::{Figure, Path3, views};
 use camkit::table::{Col, Row, Schema, Table};
 
 /// The columns written besides the shared ones: the surface touched, and in two-surface mode
@@ -69,44 +69,16 @@ pub fn table(model: &Model, paths: &[TracedPath], tag: &str, two: bool) -> Table
     t
 }
 
-/// Colours of successive passes.
-const COLOURS: [&str; 6] = ["#1f77b4", "#d62728", "#2ca02c", "#9467bd", "#ff7f0e", "#17becf"];
-
-/// Most points drawn per pass (longer passes are thinned evenly for the picture only).
-const MAX_DRAWN: usize = 4000;
-
-/// Top view of the traced stylus centres (and, in two-surface mode, both contact lines).
-pub fn plot(paths: &[TracedPath], title: &str) -> Plot {
-    let mut p = Plot::new(title, Aspect::Equal);
-    p.labels("x (mm)", "y (mm)");
-    let thin = |n: usize| n.div_ceil(MAX_DRAWN).max(1);
-    for (k, path) in paths.iter().enumerate() {
-        let every = thin(path.points.len());
-        let mut centres: Vec<P2> = path.points.iter().step_by(every).map(|q| P2::new(q.centre.x, q.centre.y)).collect();
-        if let Some(last) = path.points.last() {
-            centres.push(P2::new(last.centre.x, last.centre.y));
-        }
-        p.polyline(&centres, Style::stroke(COLOURS[k % COLOURS.len()], 1.2));
-        if path.points.iter().any(|q| q.second.is_some()) {
-            let a: Vec<P2> = path.points.iter().step_by(every).map(|q| P2::new(q.contact.x, q.contact.y)).collect();
-            let b: Vec<P2> = path
-                .points
-                .iter()
-                .step_by(every)
-                .filter_map(|q| q.second.map(|s| P2::new(s.point.x, s.point.y)))
-                .collect();
-            p.polyline(&a, Style::stroke("#555", 0.8).dashed("4 2"));
-            p.polyline(&b, Style::stroke("#999", 0.8).dashed("1 2"));
-        }
+/// The 3-D views of the traced stylus centres coloured by z (and, in two-surface mode, both
+/// contact lines under them).
+pub fn plot(paths: &[TracedPath], title: &str) -> Figure {
+    let centres: Vec<Path3> = paths.iter().map(|p| Path3::by_z(p.points.iter().map(|q| q.centre).collect())).collect();
+    let mut under = Vec::new();
+    for path in paths.iter().filter(|p| p.points.iter().any(|q| q.second.is_some())) {
+        let a = path.points.iter().map(|q| q.contact).collect();
+        let b = path.points.iter().filter_map(|q| q.second.map(|s| s.point)).collect();
+        under.push((a, Style::stroke("#555", 0.8).dashed("4 2").named("contact on surface A")));
+        under.push((b, Style::stroke("#999", 0.8).dashed("1 2").named("contact on surface B")));
     }
-    if let Some(first) = paths.first().and_then(|p| p.points.first()) {
-        p.dots(&[P2::new(first.centre.x, first.centre.y)], 3.0, Style::fill("black", 1.0));
-        p.legend("start", Style::fill("black", 1.0));
-    }
-    p.legend("stylus centre (one colour per pass)", Style::stroke(COLOURS[0], 1.2));
-    if paths.iter().any(|q| q.points.iter().any(|c| c.second.is_some())) {
-        p.legend("contact on surface A", Style::stroke("#555", 0.8).dashed("4 2"));
-        p.legend("contact on surface B", Style::stroke("#999", 0.8).dashed("1 2"));
-    }
-    p
+    views(title, &centres, "stylus centre z (mm)", &under)
 }

@@ -11,6 +11,7 @@
 pub mod edge;
 pub mod flat_type;
 pub mod gouge;
+pub mod plot;
 pub mod pose;
 
 use camkit::geom::{P3, V3};

@@ -5,13 +5,14 @@ use camkit::cli::{self, IoArgs};
 use camkit::doc::{Tool, ToolKind};
 use camkit::error::{Error, Location, Result};
 use camkit::geom::{P3, V3};
-use camkit::io::{Input, Output};
+use camkit::io::{Input, Output, write_atomic};
 use camkit::json::{at_value, field_error};
 use camkit::model::Model;
 use camkit::report::Report;
 use camkit::table::{self, Col, Field, Table, WriteOptions};
 use clap::{Parser, ValueEnum};
 use rayon::prelude::*;
+use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Instant;
 use tool_attitude::flat_type::Edge;
@@ -94,6 +95,10 @@ struct Args {
     /// Decimals of written positions (default: shortest exact text).
     #[arg(long, value_name = "N")]
     decimals: Option<u32>,
+    /// Write an SVG of the tool tip paths: isometric, top and side views coloured by the tool
+    /// axis's tilt from +z (degrees; by z for one fixed axis), the axis drawn at evenly spaced rows.
+    #[arg(long, value_name = "FILE")]
+    svg: Option<PathBuf>,
 }
 
 fn after_help() -> String {
@@ -531,6 +536,10 @@ fn deliver(args: &Args, t: &Table, input: &str, gouging: &[usize], tol: f64, lar
             return Err(Error::check(msg).at(loc));
         }
         cli::warn(&format!("{loc}: {msg}"));
+    }
+    if let Some(path) = &args.svg {
+        let title = format!("{input}: {} rows, tool tip and axis", t.rows.len());
+        write_atomic(path, tool_attitude::plot::plot(t, &title).to_svg(1200.0).as_bytes())?;
     }
     let mut out = Output::new(args.io.output.as_deref());
     table::write(&mut out, t, &WriteOptions { decimals: args.decimals })?;
