@@ -141,11 +141,11 @@ fn setup(args: &Args, tool: &Tool, tool_file: &str) -> Result<Setup> {
             let edge = Edge { included: included.to_radians(), flank };
             (Shape::FlatType { edge, control_second: args.control == ControlPoint::P3 }, 0.0, [0.0, 0.0])
         }
-        ToolKind::Bull => {
+        ToolKind::Bull | ToolKind::Cone => {
             return Err(field_error(
                 tool_file,
                 "kind",
-                "tool-attitude takes ball, flat, cylindrical-nonrotating or flat-nonrotating tools, not bull",
+                "tool-attitude takes ball, flat, cylindrical-nonrotating or flat-nonrotating tools: bull-nose and cone cutters on a fixed axis are dropped onto the model by stylus-trace --tool",
             ));
         }
     };
