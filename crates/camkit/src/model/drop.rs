@@ -4,9 +4,10 @@
 //! The model is turned once into the axis frame (the tool axis becomes +z; the frame is the
 //! shortest rotation taking the axis to +z, so for 0,0,1 it is the model's own). Meshes are
 //! dropped onto exactly (facet, vertex and edge tests of [`super::cutter`]), pruned by a
-//! hierarchy of boxes in that frame: a box whose top is not above the best tip so far, or that
-//! lies outside the cutter's shadow, is skipped. Planes, spheres and cylinders across or along
-//! the axis have closed forms. Other surfaces (cones, tori, cylinders at a slant, free-form
+//! hierarchy of boxes in that frame: a box outside the cutter's shadow, or whose top less the
+//! cutter's height at the box's distance from the axis (a bound of every tip it can give) is not
+//! above the best tip so far, is skipped. Planes, spheres and cylinders across or along the axis
+//! have closed forms. Other surfaces (cones, tori, cylinders at a slant, free-form
 //! patches) are refused by [`DropCutter::new`]: tessellate them to STL.
 
 use super::analytic::Analytic;
@@ -194,7 +195,7 @@ impl DropCutter {
                 continue;
             }
             let floor = best.map_or(f64::NEG_INFINITY, |(t, _, _)| t.tip);
-            let found = self.drop_part(q, part, floor, &shadow);
+            let found = self.drop_part(q, part, floor);
             if let Some((t, n)) = found {
                 if best.is_none_or(|(b, _, _)| t.tip > b.tip) {
                     best = Some((t, n, i));
@@ -212,11 +213,19 @@ impl DropCutter {
     }
 
     /// The drop onto one part above `floor`: the touch and the part's normal at the contact.
-    fn drop_part(&self, q: [f64; 2], part: &Part, floor: f64, shadow: &dyn Fn(&Aabb) -> bool) -> Option<(Touch, V3)> {
+    fn drop_part(&self, q: [f64; 2], part: &Part, floor: f64) -> Option<(Touch, V3)> {
         let c = &self.cutter;
         match part {
             Part::Mesh { tris, index } => {
-                let bound = |b: &Aabb| if shadow(b) && b.max.z > floor { b.max.z } else { f64::NEG_INFINITY };
+                // No point of a box is nearer the axis than the box itself, and f grows with ρ:
+                // its top less f at that distance bounds every tip it can give.
+                let bound = |b: &Aabb| {
+                    let dx = (b.min.x - q[0]).max(q[0] - b.max.x).max(0.0);
+                    let dy = (b.min.y - q[1]).max(q[1] - b.max.y).max(0.0);
+                    let rho = dx.hypot(dy);
+                    let top = if rho <= c.radius() { b.max.z - c.height(rho) } else { f64::NEG_INFINITY };
+                    if top > floor { top } else { f64::NEG_INFINITY }
+                };
                 index
                     .maximise(bound, |k| {
                         let (t, n) = &tris[k];
@@ -288,6 +297,63 @@ fn part_bounds(part: &Part) -> Aabb {
 mod tests {
     use super::*;
     use crate::io::Input;
+    use proptest::prelude::*;
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(64))]
+        /// On a random height-field mesh along a random axis, the pruned drop is the highest of
+        /// every triangle's exact drop, and no sampled point of the mesh is above the cutter.
+        #[test]
+        fn pruned_drop_is_the_brute_force_one(
+            heights in prop::collection::vec(-2.0..2.0f64, 49),
+            c in prop_oneof![
+                (0.3..4.0f64).prop_map(|radius| Cutter::Flat { radius }),
+                (0.3..4.0f64).prop_map(|radius| Cutter::Ball { radius }),
+                (0.3..4.0f64, 0.1..1.0f64).prop_map(|(radius, k)| Cutter::Bull { radius, corner: radius * k }),
+                (0.3..4.0f64, 0.3..1.3f64).prop_map(|(radius, half_angle)| Cutter::Cone { radius, half_angle }),
+            ],
+            axis in prop::array::uniform3(-0.4..0.4f64),
+            q in prop::array::uniform2(-2.0..8.0f64),
+        ) {
+            let p = |i: usize, j: usize| P3::new(i as f64, j as f64 + 0.3 * i as f64, heights[7 * i + j]);
+            let mut tris = Vec::new();
+            for i in 0..6 {
+                for j in 0..6 {
+                    tris.push([p(i, j), p(i + 1, j), p(i + 1, j + 1)]);
+                    tris.push([p(i, j), p(i + 1, j + 1), p(i, j + 1)]);
+                }
+            }
+            let mesh = super::super::mesh::Mesh::new(&tris).unwrap();
+            let m = Model { surfaces: vec![super::super::Surface::new("m".into(), Geometry::Mesh(mesh), None, false)] };
+            let axis = V3::new(axis[0], axis[1], 1.0).normalize();
+            let dc = DropCutter::new(&m, c, axis).unwrap();
+            let frame = dc.frame;
+            let mut brute: Option<Touch> = None;
+            let mut samples = f64::NEG_INFINITY;
+            for t in &tris {
+                let t = t.map(|v| frame.to_frame(&v));
+                let n = (t[1] - t[0]).cross(&(t[2] - t[0])).normalize();
+                brute = Touch::max(brute, c.drop_triangle(q, &t, &if n.z < 0.0 { -n } else { n }));
+                for a in 0..=20 {
+                    for b in 0..=20 - a {
+                        let s = t[0] + (t[1] - t[0]) * (a as f64 / 20.0) + (t[2] - t[0]) * (b as f64 / 20.0);
+                        let rho = (s.x - q[0]).hypot(s.y - q[1]);
+                        if rho <= c.radius() {
+                            samples = samples.max(s.z - c.height(rho));
+                        }
+                    }
+                }
+            }
+            let got = dc.drop(q[0], q[1]);
+            prop_assert_eq!(got.is_some(), brute.is_some());
+            if let (Some(g), Some(b)) = (got, brute) {
+                let tip = frame.to_frame(&g.tip);
+                prop_assert!((tip.z - b.tip).abs() <= 1e-12 * (1.0 + b.tip.abs()), "{} vs {}", tip.z, b.tip);
+                prop_assert!(samples <= tip.z + 1e-9, "a sample is {} above", samples - tip.z);
+                prop_assert!((g.normal.norm() - 1.0).abs() < 1e-9);
+            }
+        }
+    }
 
     fn model(text: &str) -> Model {
         Model::load(&Input { name: "m.json".into(), data: text.as_bytes().to_vec() }).unwrap()
