@@ -181,11 +181,12 @@ impl Bvh {
     /// The largest value over the items by branch and bound: `bound(box)` is an upper bound of
     /// the values of the items in the box (−∞: none counts), `visit(k)` measures item `k`
     /// (hierarchy order). Boxes are searched highest bound first and skipped once their bound
-    /// is not above the best so far; the first item reaching the largest value wins.
+    /// is not above the best so far; the first item reaching the largest value wins. `visit` is
+    /// given the best value so far (−∞ at first) and may skip an item that cannot beat it.
     pub fn maximise<T>(
         &self,
         bound: impl Fn(&Aabb) -> f64,
-        mut visit: impl FnMut(usize) -> Option<(f64, T)>,
+        mut visit: impl FnMut(usize, f64) -> Option<(f64, T)>,
     ) -> Option<(f64, T)> {
         let mut best: Option<(f64, T)> = None;
         let beats = |b: f64, best: &Option<(f64, T)>| b > f64::NEG_INFINITY && best.as_ref().is_none_or(|x| b > x.0);
@@ -204,7 +205,8 @@ impl Bvh {
             let node = self.nodes[n as usize];
             if node.count > 0 {
                 for k in node.start..node.start + node.count {
-                    if let Some((v, t)) = visit(k as usize) {
+                    let floor = best.as_ref().map_or(f64::NEG_INFINITY, |x| x.0);
+                    if let Some((v, t)) = visit(k as usize, floor) {
                         if best.as_ref().is_none_or(|x| v > x.0) {
                             best = Some((v, t));
                         }

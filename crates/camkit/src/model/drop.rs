@@ -223,12 +223,19 @@ impl DropCutter {
                     let dx = (b.min.x - q[0]).max(q[0] - b.max.x).max(0.0);
                     let dy = (b.min.y - q[1]).max(q[1] - b.max.y).max(0.0);
                     let rho = dx.hypot(dy);
-                    let top = if rho <= c.radius() { b.max.z - c.height(rho) } else { f64::NEG_INFINITY };
+                    // Taken 1e-9 nearer: rounding of ρ must not lower the bound where f is steep
+                    // (at the rim of a ball or bull-nose f′ is infinite).
+                    let top =
+                        if rho <= c.radius() { b.max.z - c.height((rho - 1e-9).max(0.0)) } else { f64::NEG_INFINITY };
                     if top > floor { top } else { f64::NEG_INFINITY }
                 };
                 index
-                    .maximise(bound, |k| {
+                    .maximise(bound, |k, best| {
                         let (t, n) = &tris[k];
+                        // The triangle's own box bounds its tips as a node's does.
+                        if bound(&Aabb::of(t)) <= best.max(floor) {
+                            return None;
+                        }
                         c.drop_triangle(q, t, n).map(|touch| (touch.tip, (touch, *n)))
                     })
                     .map(|(_, found)| found)
