@@ -133,8 +133,9 @@ fn after_help() -> String {
     s.push_str(
         "\nWith --tool (fixed-axis cutter, scan mode only): x,y,z the tool tip, i,j,k the axis, px,py,pz the\n\
          contact, nx,ny,nz the model's unit normal there, tag `drop`, surface, point `tip`. The drop is exact\n\
-         on STL meshes (facet, vertex and edge tests; the bull-nose edge within 1e-10 mm), planes, spheres and\n\
-         cylinders across the axis (endless) or along it (the upper rim); other surfaces are refused.\n",
+         on STL meshes (facet, vertex and edge tests; the bull-nose edge within 1e-10 mm), planes,\n\
+         spheres and cylinders across the axis (endless) or along it (the upper rim); other surfaces\n\
+         are refused.\n",
     );
     s.push_str(
         "\nScan mode checks every line against an independent drop of the stylus: a stretch with the model under it\n\
