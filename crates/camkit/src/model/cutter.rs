@@ -115,15 +115,17 @@ impl Cutter {
         }
     }
 
-    /// The drop onto a triangle (corners `t`, unit normal `n` with n.z ≥ 0) at `q` = (x, y).
-    pub fn drop_triangle(&self, q: [f64; 2], t: &[P3; 3], n: &V3) -> Option<Touch> {
+    /// The drop onto a triangle (corners `t`, unit normal `n` with n.z ≥ 0) at `q` = (x, y);
+    /// edges that cannot give a tip above `floor` are not solved (−∞: every one is).
+    pub fn drop_triangle(&self, q: [f64; 2], t: &[P3; 3], n: &V3, floor: f64) -> Option<Touch> {
         let mut best = None;
         for p in t {
             best = Touch::max(best, self.drop_point(q, p));
         }
         best = Touch::max(best, self.drop_facet(q, t, n));
+        let floor = best.map_or(floor, |b| b.tip.max(floor));
         for k in 0..3 {
-            best = Touch::max(best, self.drop_edge(q, &t[k], &t[(k + 1) % 3]));
+            best = Touch::max(best, self.drop_edge(q, &t[k], &t[(k + 1) % 3], floor));
         }
         best
     }
@@ -173,8 +175,9 @@ impl Cutter {
         inside.then_some(touch)
     }
 
-    /// The edge test: the largest g along the edge from `a` to `b` within the shadow.
-    pub fn drop_edge(&self, q: [f64; 2], a: &P3, b: &P3) -> Option<Touch> {
+    /// The edge test: the largest g along the edge from `a` to `b` within the shadow, if it can
+    /// be above `floor`.
+    pub fn drop_edge(&self, q: [f64; 2], a: &P3, b: &P3, floor: f64) -> Option<Touch> {
         let (ex, ey) = (b.x - a.x, b.y - a.y);
         let len = ex.hypot(ey);
         if len <= 1e-12 {
@@ -185,7 +188,9 @@ impl Cutter {
         let s1 = (a.x - q[0]) * ex + (a.y - q[1]) * ey;
         let d = ((a.x - q[0]) * ey - (a.y - q[1]) * ex).abs();
         let big_r = self.radius();
-        if d > big_r {
+        // No point of the edge is nearer the axis than its line: its top less f(d) bounds its
+        // tips (d taken 1e-9 nearer so rounding never lowers the bound where f is steep).
+        if d > big_r || a.z.max(b.z) - self.height((d - 1e-9).max(0.0)) <= floor {
             return None;
         }
         let w = (big_r * big_r - d * d).sqrt();
@@ -375,7 +380,7 @@ mod tests {
             let n = (t[1] - t[0]).cross(&(t[2] - t[0]));
             prop_assume!(n.norm() > 1e-3);
             let n = if n.z < 0.0 { -n.normalize() } else { n.normalize() };
-            let touch = c.drop_triangle(q, &t, &n);
+            let touch = c.drop_triangle(q, &t, &n, f64::NEG_INFINITY);
             let brute = sampled(&c, q, &t, 120);
             match touch {
                 None => prop_assert!(brute == f64::NEG_INFINITY, "missed: sampled {brute}"),
@@ -411,7 +416,7 @@ mod tests {
                     P3::new(50.0, -50.0, 50.0 * theta.tan()),
                     P3::new(0.0, 50.0, 0.0),
                 ];
-                let tri = c.drop_triangle([x, 1.0], &t, &n).unwrap().tip;
+                let tri = c.drop_triangle([x, 1.0], &t, &n, f64::NEG_INFINITY).unwrap().tip;
                 assert!((tri - want).abs() < 1e-9, "{tri} vs {want}");
             }
         }
@@ -423,12 +428,13 @@ mod tests {
         // reaches the edge where its profile does: tip = −f(d).
         let c = Cutter::Bull { radius: 4.0, corner: 1.5 };
         for d in [0.0, 2.0, 3.0, 3.9] {
-            let t = c.drop_edge([-d, 0.3], &P3::new(0.0, -10.0, 0.0), &P3::new(0.0, 10.0, 0.0)).unwrap();
+            let t =
+                c.drop_edge([-d, 0.3], &P3::new(0.0, -10.0, 0.0), &P3::new(0.0, 10.0, 0.0), f64::NEG_INFINITY).unwrap();
             assert!((t.tip + c.height(d)).abs() <= EDGE_TOL, "d {d}: {}", t.tip);
         }
         // A sloped edge: compare with a fine sampling of g along it.
         let (a, b) = (P3::new(-5.0, 1.2, -3.0), P3::new(5.0, 1.2, 4.0));
-        let t = c.drop_edge([0.0, 0.0], &a, &b).unwrap();
+        let t = c.drop_edge([0.0, 0.0], &a, &b, f64::NEG_INFINITY).unwrap();
         let mut best = f64::NEG_INFINITY;
         for k in 0..=2_000_000 {
             let p = a + (b - a) * (k as f64 / 2e6);

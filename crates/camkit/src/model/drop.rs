@@ -236,7 +236,7 @@ impl DropCutter {
                         if bound(&Aabb::of(t)) <= best.max(floor) {
                             return None;
                         }
-                        c.drop_triangle(q, t, n).map(|touch| (touch.tip, (touch, *n)))
+                        c.drop_triangle(q, t, n, best.max(floor)).map(|touch| (touch.tip, (touch, *n)))
                     })
                     .map(|(_, found)| found)
             }
@@ -340,7 +340,7 @@ mod tests {
             for t in &tris {
                 let t = t.map(|v| frame.to_frame(&v));
                 let n = (t[1] - t[0]).cross(&(t[2] - t[0])).normalize();
-                brute = Touch::max(brute, c.drop_triangle(q, &t, &if n.z < 0.0 { -n } else { n }));
+                brute = Touch::max(brute, c.drop_triangle(q, &t, &if n.z < 0.0 { -n } else { n }, f64::NEG_INFINITY));
                 for a in 0..=20 {
                     for b in 0..=20 - a {
                         let s = t[0] + (t[1] - t[0]) * (a as f64 / 20.0) + (t[2] - t[0]) * (b as f64 / 20.0);
