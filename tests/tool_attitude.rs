@@ -564,3 +564,40 @@ fn model_stl_slivers_are_dropped_with_a_warning_or_refused_strictly() {
     w.run(BIN, &[&args("scad.stl", "s.json")[..], &["--strict"]].concat(), b"")
         .fails(2, "scad.stl (facet 6): degenerate triangle (zero area)");
 }
+
+/// Issue 19: the stream says which stylus traced it. A ball of another radius is refused (exit 2,
+/// naming both radii), with and without --axis; the output says `point` = tip and post-6axis
+/// takes it, while it refuses the stylus-centre stream itself.
+#[test]
+fn the_stylus_radius_recorded_in_the_stream_must_be_the_balls() {
+    let w = Work::new();
+    w.write("sphere.json", r#"{"surfaces": [{"type": "sphere", "centre": [0, 0, 0], "radius": 10}]}"#);
+    w.write("ball3.json", r#"{"kind": "ball", "radius": 3}"#);
+    w.write("ball5.json", r#"{"kind": "ball", "radius": 5}"#);
+    let cl = w.run("stylus-trace", &["sphere.json", "-r", "3", "--pick", "4", "--region=-5,5,-5,5"], b"").ok();
+    w.write("cl.csv", &cl);
+    let needle =
+        "ball5.json (radius): the tool's radius 5 mm differs from the radius 3 mm of the stylus that traced cl.csv";
+    w.run(BIN, &["cl.csv", "--tool", "ball5.json", "--axis", "0,0,1", "-o", "tip.csv"], b"").fails(2, needle);
+    w.run(BIN, &["cl.csv", "--tool", "ball5.json", "-o", "tip.csv"], b"").fails(2, needle);
+    assert!(!w.exists("tip.csv"));
+    let machine = data("post-6axis/three-axis.json");
+    let machine = machine.to_str().unwrap();
+    w.run("post-6axis", &["cl.csv", "--machine", machine, "--feed", "1000", "-o", "cl.nc"], b"").fails(
+        2,
+        "cl.csv:2 (point): the stream's x,y,z are the centres of a stylus of radius 3 mm (column point = stylus-centre), not tool tips: the program would cut 3 mm in the air; run tool-attitude on it first",
+    );
+    assert!(!w.exists("cl.nc"));
+    let tips = w.run(BIN, &["cl.csv", "--tool", "ball3.json", "--axis", "0,0,1", "-o", "tip.csv"], b"");
+    tips.ok();
+    let t = Rows::parse(&w.read("tip.csv"));
+    assert!(!t.cols.contains_key("stylus_radius"));
+    assert!(t.rows.iter().all(|r| r[t.cols["point"]] == "tip"));
+    // Tips given back to --axis would be lowered a second time: refused.
+    w.run(BIN, &["tip.csv", "--tool", "ball3.json", "--axis", "0,0,1"], b"").fails(2, "tool tips already");
+    w.run("post-6axis", &["tip.csv", "--machine", machine, "--feed", "1000", "-o", "tip.nc"], b"").ok();
+    // The tilted ball takes the stream too and marks its rows tips.
+    let out = w.run(BIN, &["cl.csv", "--tool", "ball3.json"], b"").ok();
+    let t = Rows::parse(&out);
+    assert!(t.rows.iter().all(|r| r[t.cols["point"]] == "tip") && !t.cols.contains_key("stylus_radius"));
+}

@@ -12,6 +12,7 @@ use camkit::gcode::read_axes;
 use camkit::io::{Input, Output, write_atomic};
 use camkit::kinematics::Chain;
 use camkit::report::Report;
+use camkit::table::meaning::{self, Meaning};
 use camkit::table::{self, Col, WriteOptions};
 use clap::Parser;
 use post_6axis::{Settings, cl_rows, collision, judge, link, plot, post, readback};
@@ -32,7 +33,8 @@ move that keeps to one branch within each pass), blocks are inserted until \
 the controller's linear interpolation keeps the tip within --tol of the straight CL segment and the axis \
 within --angle-tol, and the written program is read back through the forward kinematics before it is \
 delivered: a program that fails the check is not written. --verify compares an existing program with the \
-rows; --reverse turns a program back into the toolpath table.",
+rows; --reverse turns a program back into the toolpath table. A stream of stylus centres (column point = \
+stylus-centre, as stylus-trace -r writes) is refused: tool-attitude turns it into tips.",
     after_help = after_help()
 )]
 struct Args {
@@ -205,6 +207,12 @@ fn run(args: Args) -> Result<()> {
         return finish(out, &args, report);
     }
     let t = table::read(&input, &[Col::X, Col::Y])?;
+    if let Meaning::StylusCentre(r) = meaning::of(&t, &input.name)? {
+        return Err(Error::input(format!(
+            "the stream's x,y,z are the centres of a stylus of radius {r} mm (column point = stylus-centre), not tool tips: the program would cut {r} mm in the air; run tool-attitude on it first"
+        ))
+        .at(Location::file(&input.name).line(t.rows[0].line).field(meaning::POINT)));
+    }
     let (rows, normalised) = cl_rows(&t, &input.name, &chain, &machine, settings.feed, settings.tol)?;
     if normalised > 0 {
         cli::warn(&format!("{normalised} tool axes were not unit vectors (within 1e-3): normalised"));

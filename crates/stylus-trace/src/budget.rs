@@ -166,6 +166,14 @@ pub fn scan_lines(region: &Region, angle: f64, pick: f64) -> f64 {
     (across / pick).floor() + 1.0
 }
 
+/// Fixed-axis cutter mode: `lines` scan lines over `region`, each no longer than its diagonal,
+/// a drop every `step` along it (and both ends).
+pub fn fixed_axis(lines: f64, region: &Region, step: f64) -> Need {
+    let diagonal = (region.x1 - region.x0).hypot(region.y1 - region.y0);
+    let points = lines * ((diagonal / step).ceil() + 2.0);
+    Need { memory: points * POINT_BYTES + lines * UNIT_BYTES, points }
+}
+
 /// Contour mode: `levels` levels across `region`, the model within `area` (the traced area); at
 /// each, at least a loop round the area's outline at the longest step, and the seed lines r apart
 /// across the whole region, each marched at steps of the order of r over the area.

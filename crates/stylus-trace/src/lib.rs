@@ -9,12 +9,15 @@
 //! ([`two_surface`]); the tracer they share is in [`curve`]; [`output`] makes the toolpath table
 //! and the plot; [`verify`] re-measures every CL point against the whole model, and in scan mode
 //! [`coverage`] compares every line with an independent drop of the stylus ([`envelope`]).
+//! [`fixed_axis`] is the other use of a scan raster: flat, ball, bull-nose and cone cutters on
+//! a fixed axis dropped exactly onto the model, giving tool tips.
 
 pub mod budget;
 pub mod contour;
 pub mod coverage;
 pub mod curve;
 pub mod envelope;
+pub mod fixed_axis;
 pub mod output;
 pub mod scan;
 pub mod two_surface;

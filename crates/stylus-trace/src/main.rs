@@ -19,7 +19,7 @@ use stylus_trace::two_surface::TwoSurface;
 use stylus_trace::{Mode, Options, Region, output};
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
-enum ModeArg {
+pub(crate) enum ModeArg {
     /// Scanning lines: vertical motion planes along --angle, --pick apart.
     Scan,
     /// Contour lines: motion plane z = const at each level.
@@ -41,15 +41,25 @@ each step as long as keeps the chord within --chord-tol of the true CL curve. Ev
 against the whole model before anything is written: no point is closer than r − --contact-tol to any part of it.",
     after_help = after_help()
 )]
-struct Args {
+pub(crate) struct Args {
     #[command(flatten)]
     io: IoArgs,
     /// Mode.
     #[arg(long, value_enum, default_value_t = ModeArg::Scan)]
     mode: ModeArg,
-    /// Stylus radius r (mm).
-    #[arg(short = 'r', long, value_name = "MM")]
-    radius: f64,
+    /// Stylus radius r (mm); or give --tool.
+    #[arg(short = 'r', long, value_name = "MM", required_unless_present = "tool", conflicts_with = "tool")]
+    radius: Option<f64>,
+    /// Fixed-axis cutter mode: the tool document (JSON, kind flat, ball, bull or cone) whose cutter
+    /// is dropped exactly onto the model along --axis at points --max-step apart on the scan
+    /// lines; writes tool tips, the axis in i,j,k, the contact and the normal.
+    #[arg(long, value_name = "FILE", conflicts_with_all = ["svg", "levels", "z_step", "surfaces", "start"])]
+    tool: Option<String>,
+    /// The fixed tool axis I,J,K with --tool (normalised; default 0,0,1). --region, --angle and
+    /// --pick are in the plane across it (the model's x,y turned by the shortest rotation taking
+    /// the axis to +z).
+    #[arg(long, value_name = "I,J,K", allow_hyphen_values = true, requires = "tool")]
+    axis: Option<String>,
     /// Region in XY as X0,X1,Y0,Y1 (mm); default: the model's bounding box.
     #[arg(long, value_name = "X0,X1,Y0,Y1", allow_hyphen_values = true, value_parser = cli::region)]
     region: Option<Region>,
@@ -119,7 +129,15 @@ fn after_help() -> String {
     ));
     s.push_str("  surface                   name of the model surface touched\n");
     s.push_str("two-surface mode adds p2x,p2y,p2z n2x,n2y,n2z surface2 (second contact) and bx,by,bz (bisector).\n");
+    s.push_str("  point, stylus_radius     `stylus-centre` and r: what x,y,z is (tool-attitude turns it into tips)\n");
     s.push_str("x,y,z is the stylus centre; nx,ny,nz is L/|L|, from the contact towards the centre.\n");
+    s.push_str(
+        "\nWith --tool (fixed-axis cutter, scan mode only): x,y,z the tool tip, i,j,k the axis, px,py,pz the\n\
+         contact, nx,ny,nz the model's unit normal there, tag `drop`, surface, point `tip`. The drop is exact\n\
+         on STL meshes (facet, vertex and edge tests; the bull-nose edge within 1e-10 mm), planes,\n\
+         spheres and cylinders across the axis (endless) or along it (the upper rim); other surfaces\n\
+         are refused.\n",
+    );
     s.push_str(
         "\nScan mode checks every line against an independent drop of the stylus: a stretch with the model under it\n\
          that no pass covers (longer than --chord-tol) or a CL point below the stylus's upper envelope (deeper than\n\
@@ -129,16 +147,18 @@ fn after_help() -> String {
     s
 }
 
+mod fixed;
+
 fn main() -> std::process::ExitCode {
     cli::run("stylus-trace", || run(cli::parse::<Args>()?))
 }
 
-fn usage(message: impl Into<String>) -> Error {
+pub(crate) fn usage(message: impl Into<String>) -> Error {
     Error::input(message)
 }
 
 /// Comma-separated finite numbers, exactly `n` of them when `n` is given.
-fn numbers(text: &str, what: &str, n: Option<usize>) -> Result<Vec<f64>> {
+pub(crate) fn numbers(text: &str, what: &str, n: Option<usize>) -> Result<Vec<f64>> {
     let v: Vec<f64> = text
         .split(',')
         .map(|t| t.trim().parse::<f64>().ok().filter(|x| x.is_finite()))
@@ -166,7 +186,7 @@ fn region(args: &Args, model: &Model, contact_tol: f64) -> Result<Region> {
 const MAX_THREADS: usize = 256;
 
 fn options(args: &Args, model: &Model, input: &Input) -> Result<Options> {
-    let radius = positive(args.radius, "--radius")?;
+    let radius = positive(args.radius.unwrap_or(f64::NAN), "--radius")?;
     let stylus = Stylus { radius, contact_tol: positive(args.contact_tol, "--contact-tol")? };
     budget::check_round_off(&[radius], stylus.contact_tol, "--radius")?;
     let steps = Steps {
@@ -308,6 +328,9 @@ fn run(args: Args) -> Result<()> {
     let model = Model::load(&input)?;
     model.check_dropped(args.strict)?;
     let loaded = started.elapsed().as_secs_f64();
+    if let Some(tool) = &args.tool {
+        return fixed::run(&args, tool, &model, &input, started, loaded);
+    }
     let opts = options(&args, &model, &input)?;
     let progress = args.io.progress(opts.mode.units() as u64, opts.mode.tag());
     let traced_at = Instant::now();
@@ -339,7 +362,7 @@ fn run(args: Args) -> Result<()> {
         ));
     }
     let tag = opts.mode.tag();
-    let t = output::table(&model, &paths, tag, two.is_some());
+    let t = output::table(&model, &paths, tag, two.is_some(), opts.stylus.radius);
     let mut out = Output::new(args.io.output.as_deref());
     table::write(&mut out, &t, &WriteOptions { decimals: args.decimals })?;
     let seconds = started.elapsed().as_secs_f64();

@@ -13,8 +13,9 @@ pub const SURFACE: &str = "surface";
 pub const SECOND: [&str; 10] = ["p2x", "p2y", "p2z", "n2x", "n2y", "n2z", "surface2", "bx", "by", "bz"];
 
 /// The toolpath table: `path` per pass, `x,y,z` the stylus centre, `px,py,pz` the contact,
-/// `nx,ny,nz` the unit normal L/|L|, `tag` the mode, then `surface` (and the second contact).
-pub fn table(model: &Model, paths: &[TracedPath], tag: &str, two: bool) -> Table {
+/// `nx,ny,nz` the unit normal L/|L|, `tag` the mode, then `surface` (and the second contact),
+/// `point` (`stylus-centre`) and `stylus_radius`: what x,y,z is, for the filters downstream.
+pub fn table(model: &Model, paths: &[TracedPath], tag: &str, two: bool, radius: f64) -> Table {
     let mut t = Table {
         schema: Schema::of(&[
             Col::Path,
@@ -66,6 +67,7 @@ pub fn table(model: &Model, paths: &[TracedPath], tag: &str, two: bool) -> Table
             t.rows.push(row);
         }
     }
+    camkit::table::meaning::mark_stylus_centre(&mut t, radius);
     t
 }
 

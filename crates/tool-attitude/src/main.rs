@@ -9,6 +9,7 @@ use camkit::io::{Input, Output, write_atomic};
 use camkit::json::{at_value, field_error};
 use camkit::model::Model;
 use camkit::report::Report;
+use camkit::table::meaning::{self, Meaning};
 use camkit::table::{self, Col, Field, Table, WriteOptions};
 use clap::{Parser, ValueEnum};
 use rayon::prelude::*;
@@ -50,7 +51,8 @@ centre, axis from the bisector of both normals corrected until the control stylu
 surface), ball (003 §3.1: tilt ζ; tip = ball centre − r·axis), flat (002 §4.2: axis = normal, machine \
 angles [a, c] of eq. 3–4). With --model every pose's tool body is tested against the model; where the tilted \
 tool cuts in, the tilt is moved inside the tool's range to the nearest clear one, and rows that stay \
-gouging fail the run (exit 1) unless --allow-gouge.",
+gouging fail the run (exit 1) unless --allow-gouge. A ball's radius must be that of the stylus the stream \
+records (column stylus_radius; else exit 2); the output's rows say point = tip.",
     after_help = after_help()
 )]
 struct Args {
@@ -60,8 +62,9 @@ struct Args {
     #[arg(short = 't', long, value_name = "FILE")]
     tool: String,
     /// A fixed tool axis I,J,K (e.g. 0,0,1 for a 3-axis machine; normalised) for a ball end mill:
-    /// the tip is the stylus centre less R along it (the stylus must have the tool's radius), the
-    /// axis columns this vector; with --model the ball and shank are gouge-checked.
+    /// the tip is the stylus centre less R along it (the stylus must have the tool's radius: a
+    /// stream recording another is refused), the axis columns this vector; with --model the ball
+    /// and shank are gouge-checked. Flat, bull-nose and cone cutters: stylus-trace --tool.
     #[arg(long, value_name = "I,J,K", allow_hyphen_values = true, conflicts_with_all = ["tilt", "edge_radius"])]
     axis: Option<String>,
     /// Tilt (degrees): θ of the cylindrical tool (paper's sign: negative leans toward the feed;
@@ -146,11 +149,11 @@ fn setup(args: &Args, tool: &Tool, tool_file: &str) -> Result<Setup> {
             let edge = Edge { included: included.to_radians(), flank };
             (Shape::FlatType { edge, control_second: args.control == ControlPoint::P3 }, 0.0, [0.0, 0.0])
         }
-        ToolKind::Bull => {
+        ToolKind::Bull | ToolKind::Cone => {
             return Err(field_error(
                 tool_file,
                 "kind",
-                "tool-attitude takes ball, flat, cylindrical-nonrotating or flat-nonrotating tools, not bull",
+                "tool-attitude takes ball, flat, cylindrical-nonrotating or flat-nonrotating tools: bull-nose and cone cutters on a fixed axis are dropped onto the model by stylus-trace --tool",
             ));
         }
     };
@@ -316,6 +319,13 @@ fn run_fixed(args: &Args, tool: &Tool, tool_file: &str, axis: V3, started: Insta
     if t.rows.is_empty() {
         return Err(Error::input("no rows").at(Location::file(&input.name)));
     }
+    if t.schema.extra_index(meaning::POINT).is_some() && meaning::of(&t, &input.name)? == Meaning::Tip {
+        return Err(Error::input(
+            "the stream's rows are tool tips already (`point` = tip): --axis takes the stylus centres stylus-trace -r writes",
+        )
+        .at(Location::file(&input.name)));
+    }
+    check_stylus(&t, &input.name, tool, tool_file)?;
     let r = tool.radius;
     let length = tool.length.unwrap_or(4.0 * r);
     let part = load_part(args, tool, length)?;
@@ -369,7 +379,7 @@ fn run_fixed(args: &Args, tool: &Tool, tool_file: &str, axis: V3, started: Insta
     if let Some(path) = &args.io.report {
         report.write(path)?;
     }
-    deliver(args, &t, &input.name, &gouging, args.gouge_tol, largest)
+    deliver(args, &mut t, &input.name, &gouging, args.gouge_tol, largest)
 }
 
 fn run(args: Args) -> Result<()> {
@@ -394,6 +404,9 @@ fn run(args: Args) -> Result<()> {
     if t.rows.is_empty() {
         return Err(Error::input("no rows: the feed direction needs at least two rows of a path")
             .at(Location::file(&input.name)));
+    }
+    if tool.kind == ToolKind::Ball {
+        check_stylus(&t, &input.name, &tool, &tool_input.name)?;
     }
     let needs_second = matches!(setup.shape, Shape::FlatType { .. });
     let cs = contacts(&t, &input.name, model, needs_second)?;
@@ -511,7 +524,7 @@ fn run(args: Args) -> Result<()> {
         report.write(path)?;
     }
     let largest = poses.iter().filter_map(|a| a.gouge).fold(0.0, f64::max);
-    deliver(&args, &t, &input.name, &gouging, setup.gouge_tol, largest)
+    deliver(&args, &mut t, &input.name, &gouging, setup.gouge_tol, largest)
 }
 
 /// The part of `--model` (none without): the model, the tool body of `length` and the model as
@@ -526,9 +539,28 @@ fn load_part(args: &Args, tool: &Tool, length: f64) -> Result<Option<Part>> {
     Part::new(model, tool, length, chord).map(Some).map_err(|e| Error::input(e).at(Location::file(file)))
 }
 
+/// A ball's centre is the stylus centre only if both have one radius: a stream that records a
+/// stylus of another radius is refused (naming both), one that records none is taken as given.
+fn check_stylus(t: &Table, file: &str, tool: &Tool, tool_file: &str) -> Result<()> {
+    if let Meaning::StylusCentre(rs) = meaning::of(t, file)? {
+        if (rs - tool.radius).abs() > 1e-9 * rs.max(1.0) {
+            return Err(field_error(
+                tool_file,
+                "radius",
+                format!(
+                    "the tool's radius {} mm differs from the radius {rs} mm of the stylus that traced {file} (column stylus_radius): the ball would not touch where the stylus did; trace again with stylus-trace -r {}",
+                    tool.radius, tool.radius
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
 /// Writes the table, after rows that gouge (indices `gouging`, the deepest `largest` mm) fail the
 /// run (exit 1, the first row named) or, with --allow-gouge, are warned of.
-fn deliver(args: &Args, t: &Table, input: &str, gouging: &[usize], tol: f64, largest: f64) -> Result<()> {
+fn deliver(args: &Args, t: &mut Table, input: &str, gouging: &[usize], tol: f64, largest: f64) -> Result<()> {
+    meaning::mark_tip(t);
     if let Some(&k) = gouging.first() {
         let msg = format!("{} row(s) gouge the model by more than {tol} mm (deepest {largest:.6} mm)", gouging.len());
         let loc = Location::file(input).line(t.rows[k].line);

@@ -122,7 +122,7 @@ pub fn default_length(tool: &Tool) -> f64 {
 
 impl Body {
     /// The body of a tool document: ball end mill a capsule (ball centre R above the tip) up the
-    /// gauge length; flat end mill and the cylindrical non-rotating tool a cylinder; bull-nose a
+    /// gauge length; flat end mill, cone cutter and the cylindrical non-rotating tool a cylinder; bull-nose a
     /// cylinder with its rims rounded by the corner radius; the flat-type non-rotating tool the
     /// wedge of its two flanks (each `flank_length` long, the included angle between them about
     /// the axis, in the plane across the edge: tool +X); and the holder's cylinder above the gauge
@@ -132,7 +132,8 @@ impl Body {
         let length = default_length(tool);
         let mut pieces = vec![match tool.kind {
             ToolKind::Ball => Piece::of(PieceKind::Capsule { from: r, to: length.max(r), radius: r }),
-            ToolKind::Flat | ToolKind::CylindricalNonrotating => {
+            // A cone cutter's body is held by the cylinder of its radius (a check errs on the safe side).
+            ToolKind::Flat | ToolKind::Cone | ToolKind::CylindricalNonrotating => {
                 Piece::of(PieceKind::Cylinder { from: 0.0, to: length, radius: r, corner: 0.0 })
             }
             ToolKind::Bull => {

@@ -2,6 +2,7 @@
 
 use crate::error::Result;
 use crate::json::field_error;
+use crate::model::cutter::Cutter;
 use serde::{Deserialize, Serialize};
 
 /// The shape of a tool.
@@ -14,6 +15,8 @@ pub enum ToolKind {
     Flat,
     /// Bull-nose end mill: flat bottom with `corner_radius` corners.
     Bull,
+    /// Cone (engraving, chamfer) cutter: a cone of `half_angle` from its tip up to `radius`.
+    Cone,
     /// Non-rotating cylindrical tool (paper 000 §2.1): the rim of a cylinder of `radius` cut square.
     CylindricalNonrotating,
     /// Non-rotating flat-type tool (paper 000 §3.2(2)): a wedge whose tip traces a concave line.
@@ -31,6 +34,9 @@ pub struct Tool {
     /// Corner radius of a bull-nose tool (mm).
     #[serde(default)]
     pub corner_radius: f64,
+    /// Half-angle of a cone cutter between its axis and its flank (degrees).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub half_angle: Option<f64>,
     /// Radius of a small flat ground at a ball end mill's tip, r0 of paper 003 (mm).
     #[serde(default)]
     pub tip_flat_radius: f64,
@@ -85,11 +91,36 @@ impl Tool {
                 format!("radius must be a positive number of mm, got {}", self.radius),
             ));
         }
-        if !(self.corner_radius >= 0.0 && self.corner_radius <= self.radius) {
-            return Err(field_error(file, "corner_radius", "corner_radius must be between 0 and radius"));
+        if !(self.corner_radius >= 0.0 && self.corner_radius.is_finite()) {
+            return Err(field_error(file, "corner_radius", "corner_radius must be a number of mm, at least 0"));
+        }
+        if self.corner_radius > self.radius {
+            return Err(field_error(
+                file,
+                "corner_radius",
+                format!(
+                    "corner_radius {} exceeds the radius {}: it can be at most the radius",
+                    self.corner_radius, self.radius
+                ),
+            ));
         }
         if self.kind == ToolKind::Bull && self.corner_radius == 0.0 {
             return Err(field_error(file, "corner_radius", "a bull-nose tool needs corner_radius > 0"));
+        }
+        match (self.kind, self.half_angle) {
+            (ToolKind::Cone, None) => {
+                return Err(field_error(file, "half_angle", "a cone cutter needs half_angle (degrees)"));
+            }
+            (ToolKind::Cone, Some(a)) if !(a > 0.0 && a < 90.0) => {
+                return Err(field_error(
+                    file,
+                    "half_angle",
+                    format!("half_angle must be between 0 and 90 degrees, got {a}"),
+                ));
+            }
+            (ToolKind::Cone, _) => {}
+            (_, Some(_)) => return Err(field_error(file, "half_angle", "half_angle is for a cone cutter")),
+            _ => {}
         }
         if !(self.tip_flat_radius >= 0.0 && self.tip_flat_radius < self.radius) {
             return Err(field_error(file, "tip_flat_radius", "tip_flat_radius must be at least 0 and below radius"));
@@ -151,6 +182,19 @@ impl Tool {
         self.feed.or_else(|| Some(self.feed_per_tooth? * f64::from(self.flutes?) * self.spindle_speed?))
     }
 
+    /// The cutter a fixed-axis drop takes, for the rotating end mills (`None` for the
+    /// non-rotating tools).
+    pub fn cutter(&self) -> Option<Cutter> {
+        let radius = self.radius;
+        Some(match self.kind {
+            ToolKind::Flat => Cutter::Flat { radius },
+            ToolKind::Ball => Cutter::Ball { radius },
+            ToolKind::Bull => Cutter::Bull { radius, corner: self.corner_radius },
+            ToolKind::Cone => Cutter::Cone { radius, half_angle: self.half_angle?.to_radians() },
+            ToolKind::CylindricalNonrotating | ToolKind::FlatNonrotating => return None,
+        })
+    }
+
     /// Reads and validates a tool document.
     pub fn read(path: &str) -> Result<Tool> {
         let input = crate::io::Input::open(path)?;
@@ -178,6 +222,17 @@ mod tests {
         assert_eq!(e.to_string(), "t.json (radius): radius must be a positive number of mm, got -1");
         let e = parse(r#"{"kind": "drill", "radius": 1}"#).unwrap_err();
         assert!(e.to_string().starts_with("t.json:1:16 (kind): unknown variant `drill`"), "{e}");
+        let e = parse(r#"{"kind": "bull", "radius": 5, "corner_radius": 6}"#).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "t.json (corner_radius): corner_radius 6 exceeds the radius 5: it can be at most the radius"
+        );
+        let t = parse(r#"{"kind": "cone", "radius": 3, "half_angle": 45}"#).unwrap();
+        assert_eq!(t.cutter(), Some(Cutter::Cone { radius: 3.0, half_angle: std::f64::consts::FRAC_PI_4 }));
+        let e = parse(r#"{"kind": "cone", "radius": 3}"#).unwrap_err();
+        assert!(e.to_string().contains("(half_angle)"), "{e}");
+        let e = parse(r#"{"kind": "cone", "radius": 3, "half_angle": 90}"#).unwrap_err();
+        assert!(e.to_string().contains("between 0 and 90"), "{e}");
         let e = parse(r#"{"kind": "bull", "radius": 5}"#).unwrap_err();
         assert!(e.to_string().contains("(corner_radius)"), "{e}");
         let t = parse(r#"{"kind": "flat-nonrotating", "radius": 5, "included_angle": 85, "flank_length": 3}"#).unwrap();

@@ -177,6 +177,58 @@ impl Bvh {
     }
 }
 
+impl Bvh {
+    /// The largest value over the items by branch and bound: `bound(box)` is an upper bound of
+    /// the values of the items in the box (−∞: none counts), `visit(k)` measures item `k`
+    /// (hierarchy order). Boxes are searched highest bound first and skipped once their bound
+    /// is not above the best so far; the first item reaching the largest value wins. `visit` is
+    /// given the best value so far (−∞ at first) and may skip an item that cannot beat it.
+    pub fn maximise<T>(
+        &self,
+        bound: impl Fn(&Aabb) -> f64,
+        mut visit: impl FnMut(usize, f64) -> Option<(f64, T)>,
+    ) -> Option<(f64, T)> {
+        let mut best: Option<(f64, T)> = None;
+        let beats = |b: f64, best: &Option<(f64, T)>| b > f64::NEG_INFINITY && best.as_ref().is_none_or(|x| b > x.0);
+        if self.order.is_empty() {
+            return None;
+        }
+        let mut stack: Vec<(u32, f64)> = Vec::with_capacity(64);
+        let root = bound(&self.nodes[0].bounds);
+        if beats(root, &best) {
+            stack.push((0, root));
+        }
+        while let Some((n, b)) = stack.pop() {
+            if !beats(b, &best) {
+                continue;
+            }
+            let node = self.nodes[n as usize];
+            if node.count > 0 {
+                for k in node.start..node.start + node.count {
+                    let floor = best.as_ref().map_or(f64::NEG_INFINITY, |x| x.0);
+                    if let Some((v, t)) = visit(k as usize, floor) {
+                        if best.as_ref().is_none_or(|x| v > x.0) {
+                            best = Some((v, t));
+                        }
+                    }
+                }
+            } else {
+                let (a, c) = (node.start, node.start + 1);
+                let (ba, bc) = (bound(&self.nodes[a as usize].bounds), bound(&self.nodes[c as usize].bounds));
+                // The higher bound is pushed last, so searched first.
+                let ((hi, bh), (lo, bl)) = if ba >= bc { ((a, ba), (c, bc)) } else { ((c, bc), (a, ba)) };
+                if beats(bl, &best) {
+                    stack.push((lo, bl));
+                }
+                if beats(bh, &best) {
+                    stack.push((hi, bh));
+                }
+            }
+        }
+        best
+    }
+}
+
 /// Makes node `n` over `order[lo..]` (its slice) and recurses.
 fn split(nodes: &mut Vec<Node>, n: usize, order: &mut [u32], lo: u32, boxes: &[Aabb], centres: &[P3]) {
     let bounds = order.iter().fold(Aabb::empty(), |b, &i| b.union(&boxes[i as usize]));

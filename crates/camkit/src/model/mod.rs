@@ -7,10 +7,14 @@
 //! there, the distance and which surface it is on: exact for analytic surfaces and meshes,
 //! converged to [`patch::FOOT_TOL`] for B-spline patches (with a flag when Newton failed).
 //! [`Model::nearest_on`] asks one surface only (two-surface contact); `nearest_within` prunes by
-//! a distance bound, which makes clearance checks of many points cheap.
+//! a distance bound, which makes clearance checks of many points cheap. [`drop::DropCutter`]
+//! answers the other question of fixed-axis machining: how high does a cutter ([`cutter`]) rest
+//! on the model along its axis.
 
 pub mod analytic;
 pub mod bvh;
+pub mod cutter;
+pub mod drop;
 pub mod mesh;
 pub mod patch;
 

@@ -94,6 +94,13 @@ pub const COLUMNS: &[ColumnSpec] = &[
     typed!(Ny, "ny", "unit vector", "empty", "unit surface normal, y"),
     typed!(Nz, "nz", "unit vector", "empty", "unit surface normal, z"),
     typed!(Tag, "tag", "text", "empty", "free label (trochoid, contour, probe, ...)"),
+    named!(
+        "point",
+        "tip|stylus-centre",
+        "tip",
+        "what x,y,z is: a tool tip, or the centre of a stylus (stylus-trace's ball stream; tool-attitude turns it into tips, post-6axis refuses it)"
+    ),
+    named!("stylus_radius", "mm", "empty", "radius of the stylus whose centre x,y,z is (stylus-centre rows)"),
     named!("surface", "text", "empty", "stylus-trace: name of the model surface the contact point lies on"),
     named!("p2x", "mm", "empty", "stylus-trace two-surface mode: contact point on the second surface, x"),
     named!("p2y", "mm", "empty", "second contact point, y"),

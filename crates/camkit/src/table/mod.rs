@@ -3,6 +3,7 @@
 //! carried through unchanged.
 
 pub mod columns;
+pub mod meaning;
 mod read;
 mod write;
 
