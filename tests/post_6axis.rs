@@ -874,9 +874,14 @@ fn numeric_options_and_mutated_documents_are_refused_or_posted() {
     setup["tool"] = jobs("flat-d0.2.json").into();
     setup["part"]["model"] = jobs("globe-sphere.json").into();
     setup["plunge"] = serde_json::json!({"feed": 1e-9});
-    w.write("setup.json", setup.to_string());
-    check(&["nf.csv", "-m", &machine("paper002-ac.json"), "--setup", "setup.json", "--feed", "500"])
-        .fails(2, "setup.json:1:299 (plunge.feed): the plunge feed must be from 0.1 to 1000000, got 1e-9");
+    let text = setup.to_string();
+    w.write("setup.json", &text);
+    // The column of the value (it moves with the length of the absolute paths before it).
+    let column = text.find(r#""plunge":{"feed":"#).expect("plunge written") + r#""plunge":{"feed":"#.len() + 1;
+    check(&["nf.csv", "-m", &machine("paper002-ac.json"), "--setup", "setup.json", "--feed", "500"]).fails(
+        2,
+        &format!("setup.json:1:{column} (plunge.feed): the plunge feed must be from 0.1 to 1000000, got 1e-9"),
+    );
     eprintln!("outcomes (exit 0, 1, 2): {seen:?}");
     assert!(seen[0] > 20 && seen[2] > 100, "{seen:?}");
 }
