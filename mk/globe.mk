@@ -11,8 +11,7 @@ FILTERS += surf-probe-fit offset post-6axis
 GLOBE := $(OUT)/globe
 GLOBE_TRUE ?= data/surf-probe-fit/globe-true.json
 GLOBE_MACHINE ?= data/post-6axis/paper002-ac.json
-GLOBE_X ?= -28,34
-GLOBE_Y ?= -31,29
+GLOBE_REGION ?= -28,34,-31,29
 GLOBE_STEP ?= 2
 GLOBE_Z ?= 115.5
 GLOBE_EVERY ?= 5
@@ -30,7 +29,7 @@ GLOBE_SETUP ?= data/jobs/globe.json
 demo-globe: $(GLOBE)/summary.txt $(GLOBE)/plan.ngc $(GLOBE)/globe.ngc
 
 $(GLOBE)/raster.csv: mk/globe.mk $(RELEASE)/surf-probe-fit | $(GLOBE)/
-	$(RELEASE)/surf-probe-fit raster --x $(GLOBE_X) --y $(GLOBE_Y) --step $(GLOBE_STEP) --z $(GLOBE_Z) -o $@
+	$(RELEASE)/surf-probe-fit raster --region=$(GLOBE_REGION) --step $(GLOBE_STEP) --z $(GLOBE_Z) -o $@
 
 $(GLOBE)/raster-records.csv: $(GLOBE)/raster.csv $(GLOBE_TRUE) $(RELEASE)/surf-probe-fit
 	$(RELEASE)/surf-probe-fit simulate $< --shape $(GLOBE_TRUE) --standoff $(GLOBE_STANDOFF) --seed $(GLOBE_SEED) --report $(GLOBE)/raster-records.json -o $@

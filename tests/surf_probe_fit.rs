@@ -397,7 +397,7 @@ fn work_past_the_bound_is_refused_before_it_starts() {
     let coast = d("surf-probe-fit/honshu-coastline.json");
     let frame = d("surf-probe-fit/globe-true.json");
     let cases: [(&[&str], &str); 5] = [
-        (&["raster", "--x", "0,1e5", "--y", "0,10", "--step", "1e-9", "--z", "10"], "the raster of --x, --y at --step"),
+        (&["raster", "--x", "0,1e5", "--y", "0,10", "--step", "1e-9", "--z", "10"], "the raster of --region at --step"),
         (
             &["reference", "--points", "1000000000000"],
             "--points would give 1.0000e12 rows, more than --max-points 1000000",
@@ -584,4 +584,18 @@ fn every_numeric_option_survives_extreme_values() {
         }
     }
     assert!(runs >= 300, "{runs} runs");
+}
+
+/// One spelling of a rectangle (issue 21): `raster --region X0,X1,Y0,Y1` as in stylus-trace and
+/// rough-sim writes the same raster as the older `--x MIN,MAX --y MIN,MAX`; a reversed range is
+/// refused naming `--region`.
+#[test]
+fn raster_region_is_spelt_as_everywhere() {
+    let w = Work::new();
+    let new = w.run(BIN, &["raster", "--region=-8,14,-11,7", "--step", "2", "--z", "115.5"], b"").ok();
+    let old = w.run(BIN, &["raster", "--x", "-8,14", "--y", "-11,7", "--step", "2", "--z", "115.5"], b"").ok();
+    assert_eq!(new, old);
+    assert!(new.lines().count() > 100, "{new}");
+    w.run(BIN, &["raster", "--region=14,-8,-11,7", "--z", "115.5"], b"").fails(2, "--region");
+    w.run(BIN, &["raster", "--z", "115.5"], b"").fails(2, "--region");
 }

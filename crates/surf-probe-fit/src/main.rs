@@ -209,11 +209,14 @@ struct RasterArgs {
     out: OutArgs,
     #[command(flatten)]
     limit: LimitArgs,
-    /// X range `MIN,MAX` (mm).
-    #[arg(long, value_name = "MIN,MAX", value_delimiter = ',', allow_hyphen_values = true, required = true, value_parser = cli::finite)]
+    /// The rectangle rastered, X0,X1,Y0,Y1 (mm), as every filter spells it.
+    #[arg(long, value_name = "X0,X1,Y0,Y1", allow_hyphen_values = true, value_parser = cli::region, required_unless_present_all = ["x", "y"])]
+    region: Option<camkit::geom::Region>,
+    /// The older spelling of the region's X range `MIN,MAX` (mm), with --y.
+    #[arg(long, value_name = "MIN,MAX", value_delimiter = ',', allow_hyphen_values = true, value_parser = cli::finite, hide = true, requires = "y", conflicts_with = "region")]
     x: Vec<f64>,
-    /// Y range `MIN,MAX` (mm).
-    #[arg(long, value_name = "MIN,MAX", value_delimiter = ',', allow_hyphen_values = true, required = true, value_parser = cli::finite)]
+    /// The older spelling of the region's Y range `MIN,MAX` (mm), with --x.
+    #[arg(long, value_name = "MIN,MAX", value_delimiter = ',', allow_hyphen_values = true, value_parser = cli::finite, hide = true, requires = "x", conflicts_with = "region")]
     y: Vec<f64>,
     /// Spacing of the raster in X and Y (mm).
     #[arg(long, default_value_t = 2.0, value_name = "MM", value_parser = cli::finite)]
@@ -698,20 +701,30 @@ fn write_table(t: &Table, out: &OutArgs, report: &Report) -> Result<()> {
 
 fn run_raster(args: RasterArgs) -> Result<()> {
     let step = positive_mm(args.step, "--step")?;
-    if args.x.len() != 2 || args.y.len() != 2 {
-        return Err(Error::input("--x and --y take two numbers: MIN,MAX"));
-    }
-    for (v, what) in args.x.iter().map(|v| (v, "--x")).chain(args.y.iter().map(|v| (v, "--y"))) {
-        mm(*v, what)?;
-    }
+    let (x0, x1, y0, y1) = match args.region {
+        Some(r) => {
+            for v in [r.x0, r.x1, r.y0, r.y1] {
+                mm(v, "--region")?;
+            }
+            (r.x0, r.x1, r.y0, r.y1)
+        }
+        None => {
+            if args.x.len() != 2 || args.y.len() != 2 {
+                return Err(Error::input("--x and --y take two numbers: MIN,MAX"));
+            }
+            for (v, what) in args.x.iter().map(|v| (v, "--x")).chain(args.y.iter().map(|v| (v, "--y"))) {
+                mm(*v, what)?;
+            }
+            if !(args.x[0] < args.x[1] && args.y[0] < args.y[1]) {
+                return Err(Error::input("--x and --y must be ranges MIN,MAX with MIN < MAX"));
+            }
+            (args.x[0], args.x[1], args.y[0], args.y[1])
+        }
+    };
     mm(args.z, "--z")?;
-    let (x0, x1, y0, y1) = (args.x[0], args.x[1], args.y[0], args.y[1]);
-    if !(x0 < x1 && y0 < y1) {
-        return Err(Error::input("--x and --y must be ranges MIN,MAX with MIN < MAX"));
-    }
     // Counted in floating point: the product of two huge counts must not wrap.
     let (fx, fy) = (((x1 - x0) / step).floor(), ((y1 - y0) / step).floor());
-    args.limit.check((fx + 1.0) * (fy + 1.0), &format!("the raster of --x, --y at --step {step}"))?;
+    args.limit.check((fx + 1.0) * (fy + 1.0), &format!("the raster of --region at --step {step}"))?;
     let (nx, ny) = (fx as usize, fy as usize);
     // Written row by row as made: the raster is never held.
     let t = pose_table(&[]);
