@@ -1178,8 +1178,8 @@ fn fixed_axis_bad_input() {
     w.write("cyl.json", r#"{"kind": "cylindrical-nonrotating", "radius": 3}"#);
     let go = |args: &[&str]| w.run(BIN, &[args, &["-o", "out.csv"]].concat(), b"");
     go(&["sphere.json", "--tool", "bull.json"])
-        .fails(2, "bull.json (corner_radius): corner_radius 4 exceeds the radius 3");
-    go(&["sphere.json", "--tool", "cone.json"]).fails(2, "cone.json (half_angle): a cone cutter needs half_angle");
+        .fails(2, "bull.json:1:48 (corner_radius): corner_radius 4 exceeds the radius 3");
+    go(&["sphere.json", "--tool", "cone.json"]).fails(2, "cone.json:1:1 (half_angle): a cone cutter needs half_angle");
     go(&["sphere.json", "--tool", "cyl.json"]).fails(2, "does not rotate");
     go(&["torus.json", "--tool", "ball.json"]).fails(2, "torus.json: surface torus#0: torus surfaces are not handled");
     go(&["sphere.json", "--tool", "ball.json", "--mode", "contour"]).fails(2, "--mode scan only");
