@@ -48,6 +48,24 @@ pub fn height_grid(
     Ok(lines)
 }
 
+/// [`height_grid`] of [`MAX_NODES`] over the x, y box of the finite points `over` (none without
+/// any).
+pub fn grid_under<'a>(
+    model: &Model,
+    over: impl IntoIterator<Item = &'a P3>,
+) -> Result<Vec<(Vec<P3>, Style)>, Unsupported> {
+    let (lo, hi) = over
+        .into_iter()
+        .filter(|p| p.coords.iter().all(|v| v.is_finite()))
+        .fold(([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]), |(lo, hi), p| {
+            ([lo[0].min(p.x), lo[1].min(p.y)], [hi[0].max(p.x), hi[1].max(p.y)])
+        });
+    if lo[0] > hi[0] {
+        return Ok(Vec::new());
+    }
+    height_grid(model, lo, hi, MAX_NODES)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
