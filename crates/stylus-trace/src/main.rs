@@ -377,10 +377,7 @@ fn run(args: Args) -> Result<()> {
             verified.points
         );
         let centres = paths.iter().flat_map(|p| p.points.iter().map(|q| &q.centre));
-        let under = relief::grid_under(&model, centres).unwrap_or_else(|e| {
-            cli::warn(&format!("--svg: no model under the paths ({}: {})", model.surfaces[e.surface].name, e.what));
-            Vec::new()
-        });
+        let under = relief::grid_under(&model, centres);
         write_atomic(path, output::plot(&paths, &title, &under).to_svg(1200.0).as_bytes())?;
     }
     if let Some(path) = &args.io.report {

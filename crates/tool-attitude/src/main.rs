@@ -581,12 +581,7 @@ fn deliver(
     }
     if let Some(path) = &args.svg {
         let title = format!("{input}: {} rows, tool tip and axis", t.rows.len());
-        let under = model.map_or(Ok(Vec::new()), |m| relief::grid_under(m, t.rows.iter().map(|r| &r.pos)));
-        let under = under.unwrap_or_else(|e| {
-            let name = model.map_or("", |m| &m.surfaces[e.surface].name);
-            cli::warn(&format!("--svg: no model under the paths ({name}: {})", e.what));
-            Vec::new()
-        });
+        let under = model.map_or_else(Vec::new, |m| relief::grid_under(m, t.rows.iter().map(|r| &r.pos)));
         write_atomic(path, tool_attitude::plot::plot(t, &title, &under).to_svg(1200.0).as_bytes())?;
     }
     let mut out = Output::new(args.io.output.as_deref());
