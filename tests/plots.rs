@@ -4,6 +4,7 @@
 //! the report), and demo-sized inputs stay well under 1 MB.
 
 use camkit::svg::inspect::{Seen, inspect};
+use camkit::svg::relief;
 use e2e::{Work, data};
 use std::collections::BTreeSet;
 
@@ -66,6 +67,13 @@ fn stylus_trace_draws_3d_views_coloured_by_the_written_z() {
     let seen = plot(&w, "cl.svg");
     assert_eq!(seen.bars.len(), 4, "isometric, top and two side views");
     bars_span(&seen, column_range(&w, "cl.csv", "z"), 0.0, "stylus centre z (mm)");
+    assert!(seen.legend.is_empty(), "the model's grid is not in the legend: {:?}", seen.legend);
+    assert_eq!(grid_lines(&w, "cl.svg"), 4 * 2 * relief::MAX_NODES, "the sphere's grid in every panel");
+}
+
+/// The model's grid lines ([`relief`]) drawn in the plot `name` of `w`.
+fn grid_lines(w: &Work, name: &str) -> usize {
+    w.read(name).matches(&format!("stroke=\"{}\"", relief::style().stroke)).count()
 }
 
 #[test]
@@ -252,7 +260,19 @@ fn tool_attitude_colours_the_tip_paths_by_the_written_axis_tilt() {
     .ok();
     w.run(
         "tool-attitude",
-        &["cl.csv", "--tool", tool.to_str().unwrap(), "--tilt", "-5", "--svg", "t.svg", "-o", "t.csv"],
+        &[
+            "cl.csv",
+            "--tool",
+            tool.to_str().unwrap(),
+            "--tilt",
+            "-5",
+            "--model",
+            model.to_str().unwrap(),
+            "--svg",
+            "t.svg",
+            "-o",
+            "t.csv",
+        ],
         b"",
     )
     .ok();
@@ -267,4 +287,5 @@ fn tool_attitude_colours_the_tip_paths_by_the_written_axis_tilt() {
     // The CSV's k is the shortest exact text of the same number: the same angle.
     bars_span(&seen, range, 1e-9, "tool tip: axis tilt from +z (°)");
     assert_eq!(seen.drawn.len(), 1, "the tool axis strokes: {:?}", seen.drawn);
+    assert_eq!(grid_lines(&w, "t.svg"), 4 * 2 * relief::MAX_NODES, "the sphere's grid in every panel");
 }

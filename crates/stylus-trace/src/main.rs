@@ -7,6 +7,7 @@ use camkit::io::{Input, Output, write_atomic};
 use camkit::model::Model;
 use camkit::num::round_to;
 use camkit::report::Report;
+use camkit::svg::relief;
 use camkit::table::{self, Col, WriteOptions};
 use clap::{Parser, ValueEnum};
 use std::path::PathBuf;
@@ -375,7 +376,9 @@ fn run(args: Args) -> Result<()> {
             paths.len(),
             verified.points
         );
-        write_atomic(path, output::plot(&paths, &title).to_svg(1200.0).as_bytes())?;
+        let centres = paths.iter().flat_map(|p| p.points.iter().map(|q| &q.centre));
+        let under = relief::grid_under(&model, centres);
+        write_atomic(path, output::plot(&paths, &title, &under).to_svg(1200.0).as_bytes())?;
     }
     if let Some(path) = &args.io.report {
         let iterations: Vec<u32> = paths.iter().flat_map(|p| p.points.iter().map(|q| q.iterations)).collect();

@@ -1,6 +1,7 @@
 //! The traced paths as the toolpath table and as a plot.
 
 use crate::TracedPath;
+use camkit::geom::P3;
 use camkit::model::Model;
 use camkit::svg::Style;
 use camkit::svg::figure::{Figure, Path3, views};
@@ -71,11 +72,11 @@ pub fn table(model: &Model, paths: &[TracedPath], tag: &str, two: bool, radius: 
     t
 }
 
-/// The 3-D views of the traced stylus centres coloured by z (and, in two-surface mode, both
-/// contact lines under them).
-pub fn plot(paths: &[TracedPath], title: &str) -> Figure {
+/// The 3-D views of the traced stylus centres coloured by z over `model` (the model's lines, see
+/// [`camkit::svg::relief`]) and, in two-surface mode, both contact lines.
+pub fn plot(paths: &[TracedPath], title: &str, model: &[(Vec<P3>, Style)]) -> Figure {
     let centres: Vec<Path3> = paths.iter().map(|p| Path3::by_z(p.points.iter().map(|q| q.centre).collect())).collect();
-    let mut under = Vec::new();
+    let mut under = model.to_vec();
     for path in paths.iter().filter(|p| p.points.iter().any(|q| q.second.is_some())) {
         let a = path.points.iter().map(|q| q.contact).collect();
         let b = path.points.iter().filter_map(|q| q.second.map(|s| s.point)).collect();

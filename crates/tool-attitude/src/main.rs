@@ -9,6 +9,7 @@ use camkit::io::{Input, Output, write_atomic};
 use camkit::json::{at_value, field_error};
 use camkit::model::Model;
 use camkit::report::Report;
+use camkit::svg::relief;
 use camkit::table::meaning::{self, Meaning};
 use camkit::table::{self, Col, Field, Table, WriteOptions};
 use clap::{Parser, ValueEnum};
@@ -379,7 +380,7 @@ fn run_fixed(args: &Args, tool: &Tool, tool_file: &str, axis: V3, started: Insta
     if let Some(path) = &args.io.report {
         report.write(path)?;
     }
-    deliver(args, &mut t, &input.name, &gouging, args.gouge_tol, largest)
+    deliver(args, &mut t, &input.name, part.as_ref().map(|p| &p.model), &gouging, args.gouge_tol, largest)
 }
 
 fn run(args: Args) -> Result<()> {
@@ -524,7 +525,7 @@ fn run(args: Args) -> Result<()> {
         report.write(path)?;
     }
     let largest = poses.iter().filter_map(|a| a.gouge).fold(0.0, f64::max);
-    deliver(&args, &mut t, &input.name, &gouging, setup.gouge_tol, largest)
+    deliver(&args, &mut t, &input.name, model, &gouging, setup.gouge_tol, largest)
 }
 
 /// The part of `--model` (none without): the model, the tool body of `length` and the model as
@@ -558,8 +559,17 @@ fn check_stylus(t: &Table, file: &str, tool: &Tool, tool_file: &str) -> Result<(
 }
 
 /// Writes the table, after rows that gouge (indices `gouging`, the deepest `largest` mm) fail the
-/// run (exit 1, the first row named) or, with --allow-gouge, are warned of.
-fn deliver(args: &Args, t: &mut Table, input: &str, gouging: &[usize], tol: f64, largest: f64) -> Result<()> {
+/// run (exit 1, the first row named) or, with --allow-gouge, are warned of; the plot is drawn
+/// over `model`.
+fn deliver(
+    args: &Args,
+    t: &mut Table,
+    input: &str,
+    model: Option<&Model>,
+    gouging: &[usize],
+    tol: f64,
+    largest: f64,
+) -> Result<()> {
     meaning::mark_tip(t);
     if let Some(&k) = gouging.first() {
         let msg = format!("{} row(s) gouge the model by more than {tol} mm (deepest {largest:.6} mm)", gouging.len());
@@ -571,7 +581,8 @@ fn deliver(args: &Args, t: &mut Table, input: &str, gouging: &[usize], tol: f64,
     }
     if let Some(path) = &args.svg {
         let title = format!("{input}: {} rows, tool tip and axis", t.rows.len());
-        write_atomic(path, tool_attitude::plot::plot(t, &title).to_svg(1200.0).as_bytes())?;
+        let under = model.map_or_else(Vec::new, |m| relief::grid_under(m, t.rows.iter().map(|r| &r.pos)));
+        write_atomic(path, tool_attitude::plot::plot(t, &title, &under).to_svg(1200.0).as_bytes())?;
     }
     let mut out = Output::new(args.io.output.as_deref());
     table::write(&mut out, t, &WriteOptions { decimals: args.decimals })?;

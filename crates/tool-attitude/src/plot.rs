@@ -10,8 +10,9 @@ use camkit::table::Table;
 const AXIS_STROKES: usize = 150;
 
 /// The 3-D views of `t`'s tip paths, one per pass, coloured by the axis tilt (degrees), or by
-/// the tip's z when every row has the same axis (a fixed-axis tool).
-pub fn plot(t: &Table, title: &str) -> Figure {
+/// the tip's z when every row has the same axis (a fixed-axis tool), over `model` (the model's
+/// lines, see [`camkit::svg::relief`]).
+pub fn plot(t: &Table, title: &str, model: &[(Vec<P3>, Style)]) -> Figure {
     let tilt = |r: &camkit::table::Row| r.axis.z.clamp(-1.0, 1.0).acos().to_degrees();
     let fixed = t.rows.windows(2).all(|w| w[0].axis == w[1].axis);
     let paths: Vec<Path3> = t
@@ -31,8 +32,8 @@ pub fn plot(t: &Table, title: &str) -> Figure {
     let len = if lo.x.is_finite() { 0.03 * (hi - lo).norm().max(1e-6) } else { 0.0 };
     let every = t.rows.len().div_ceil(AXIS_STROKES).max(1);
     let style = Style::stroke("#555555", 0.7).named(&format!("tool axis (every {every} rows)"));
-    let axes =
-        t.rows.iter().step_by(every).map(|r| (vec![r.pos, r.pos + r.axis * len], style.clone())).collect::<Vec<_>>();
+    let mut under = model.to_vec();
+    under.extend(t.rows.iter().step_by(every).map(|r| (vec![r.pos, r.pos + r.axis * len], style.clone())));
     let bar = if fixed { "tool tip z (mm), fixed axis" } else { "tool tip: axis tilt from +z (°)" };
-    views(title, &paths, bar, &axes)
+    views(title, &paths, bar, &under)
 }

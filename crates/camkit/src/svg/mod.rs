@@ -11,6 +11,7 @@
 
 pub mod figure;
 pub mod inspect;
+pub mod relief;
 mod simplify;
 
 use crate::geom::{Arc2, P2};
