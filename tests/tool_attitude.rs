@@ -576,8 +576,7 @@ fn the_stylus_radius_recorded_in_the_stream_must_be_the_balls() {
     w.write("ball5.json", r#"{"kind": "ball", "radius": 5}"#);
     let cl = w.run("stylus-trace", &["sphere.json", "-r", "3", "--pick", "4", "--region=-5,5,-5,5"], b"").ok();
     w.write("cl.csv", &cl);
-    let needle =
-        "ball5.json (radius): the tool's radius 5 mm differs from the radius 3 mm of the stylus that traced cl.csv";
+    let needle = "ball5.json:1:28 (radius): the tool's radius 5 mm differs from the radius 3 mm of the stylus that traced cl.csv";
     w.run(BIN, &["cl.csv", "--tool", "ball5.json", "--axis", "0,0,1", "-o", "tip.csv"], b"").fails(2, needle);
     w.run(BIN, &["cl.csv", "--tool", "ball5.json", "-o", "tip.csv"], b"").fails(2, needle);
     assert!(!w.exists("tip.csv"));

@@ -407,7 +407,7 @@ fn run(args: Args) -> Result<()> {
             .at(Location::file(&input.name)));
     }
     if tool.kind == ToolKind::Ball {
-        check_stylus(&t, &input.name, &tool, &tool_input.name)?;
+        check_stylus(&t, &input.name, &tool, &tool_input.name).map_err(|e| at_value(&tool_input, e))?;
     }
     let needs_second = matches!(setup.shape, Shape::FlatType { .. });
     let cs = contacts(&t, &input.name, model, needs_second)?;
