@@ -1129,40 +1129,11 @@ fn fixed_axis_cutters_on_analytic_models() {
         assert!((a - axis).norm() < 1e-12);
         assert!(((tip + axis * 2.0).coords.norm() - 12.0).abs() < 1e-9, "{tip}");
     }
-    let two = w.run(
-        BIN,
-        &[
-            "sphere.json",
-            "--tool",
-            "ball.json",
-            "--pick",
-            "0.5",
-            "--max-step",
-            "0.5",
-            "--axis",
-            "1,-1,2",
-            "--threads",
-            "2",
-        ],
-        b"",
-    );
-    let one = w.run(
-        BIN,
-        &[
-            "sphere.json",
-            "--tool",
-            "ball.json",
-            "--pick",
-            "0.5",
-            "--max-step",
-            "0.5",
-            "--axis",
-            "1,-1,2",
-            "--threads",
-            "1",
-        ],
-        b"",
-    );
+    let threads = |n: &str| {
+        let args = ["--tool", "ball.json", "--pick", "0.5", "--max-step", "0.5", "--axis", "1,-1,2", "--threads", n];
+        w.run(BIN, &[&["sphere.json"][..], &args].concat(), b"")
+    };
+    let (two, one) = (threads("2"), threads("1"));
     assert_eq!(one.ok(), two.ok());
 }
 
