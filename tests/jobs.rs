@@ -543,3 +543,16 @@ fn the_part_check_shows_progress_on_a_terminal_only() {
     assert!(tty.status.success(), "{tty:?}");
     assert!(String::from_utf8_lossy(&tty.stdout).contains("checking against the part"), "{tty:?}");
 }
+
+/// A cone cutter is not linked or checked with a setup: the stock model would take its V groove
+/// for a flat end mill's full-width slot and let rapids pass through stock still standing. Refused
+/// naming the setup's tool (exit 2), no program written.
+#[test]
+fn a_cone_cutter_is_refused_with_a_setup() {
+    let w = job();
+    w.write("tool.json", r#"{"kind": "cone", "radius": 4, "half_angle": 45, "number": 7, "plunge_feed": 200}"#);
+    let m = machine();
+    w.run(BIN, &["passes.csv", "--machine", &m, "--setup", "setup.json", "-o", "p.ngc"], b"")
+        .fails(2, "setup.json:1:10 (tool): ./tool.json is a cone cutter");
+    assert!(!w.exists("p.ngc"));
+}

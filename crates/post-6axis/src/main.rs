@@ -138,6 +138,17 @@ fn with_job(mut machine: Machine, job: &Job) -> Result<Machine> {
 fn run(args: Args) -> Result<()> {
     let started = Instant::now();
     let job = args.setup.as_deref().map(Setup::read).transpose()?;
+    if let Some(j) = job.as_ref().filter(|j| j.tool.kind == camkit::doc::ToolKind::Cone) {
+        // The stock model cuts as a flat end mill would: it would count a cone's V groove as a
+        // full-width slot and pass rapids through stock still standing.
+        return Err(j.error(
+            "tool",
+            format!(
+                "{} is a cone cutter: linking and the collision check model the stock a flat, ball or bull-nose end mill leaves, not a cone's; post its passes without --setup (they are not linked) or with one of those tools",
+                j.tool_file
+            ),
+        ));
+    }
     let (machine, chain) = load_machine(&args)?;
     let within = |v: f64, (lo, hi): (f64, f64), what: &str| {
         positive(v, what).and_then(|v| match v {
