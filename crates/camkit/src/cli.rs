@@ -111,31 +111,6 @@ pub enum Kind {
     Gcode,
 }
 
-impl Kind {
-    /// `Auto` decided by the name of `input`; the others as they are.
-    pub fn resolve(self, input: &crate::io::Input) -> Kind {
-        self.resolve_name(&input.name)
-    }
-
-    /// `Auto` decided by an input's name as given (`-`: standard input, a table); the others as
-    /// they are.
-    pub fn resolve_name(self, name: &str) -> Kind {
-        let extension = std::path::Path::new(name).extension().and_then(|e| e.to_str()).unwrap_or("");
-        match self {
-            Kind::Auto
-                if matches!(
-                    extension.to_ascii_lowercase().as_str(),
-                    "nc" | "ngc" | "gcode" | "gco" | "g" | "tap" | "cnc"
-                ) =>
-            {
-                Kind::Gcode
-            }
-            Kind::Auto => Kind::Table,
-            k => k,
-        }
-    }
-}
-
 /// Prints a warning on stderr (`name: warning: ...`).
 pub fn warn(message: &str) {
     eprintln!("{}: warning: {}", program(), printable(message));
