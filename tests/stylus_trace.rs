@@ -1177,3 +1177,29 @@ fn the_stylus_stream_records_its_meaning() {
         assert_eq!((f[p], f[r]), ("stylus-centre", "3"));
     }
 }
+
+/// A stray vertex 12 km above a wavy field (one triangle turned into a needle, as a mangled STL
+/// has it): the drops beside the needle no longer creep down its whole height (more than 60 s
+/// of CPU before), and the scan still covers the envelope. Run under a 20 s CPU limit.
+#[test]
+fn a_needle_12_km_tall_is_traced_at_once() {
+    let mut tris = as_f32(&wave());
+    tris[300][1].z = 12_345.678;
+    let w = Work::new();
+    w.write("needle.stl", camkit::model::mesh::binary_stl(&tris));
+    let run = std::process::Command::new("sh")
+        .current_dir(w.path(""))
+        .arg("-c")
+        .arg("ulimit -t 20; exec \"$0\" needle.stl --mode scan -r 3 --pick 4 -o cl.csv --report r.json")
+        .arg(e2e::bin(BIN))
+        .output()
+        .unwrap();
+    assert_eq!(run.status.code(), Some(0), "{}", String::from_utf8_lossy(&run.stderr));
+    let mut r = report(&w, "r.json");
+    r["exit_status"] = 0.into();
+    let cl = rows(&w.read("cl.csv"));
+    let stored = as_f32(&tris);
+    let (gap, below) = coverage_along_x(&cl, 0.0, 60.0, &|x, y| drop_on_mesh(&stored, x, y, 3.0));
+    assert_covered(&r, gap, below);
+    assert!(cl.iter().any(|q| q.c.z > 1000.0), "no pass goes over the needle");
+}

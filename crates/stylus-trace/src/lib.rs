@@ -22,9 +22,11 @@ pub mod output;
 pub mod scan;
 pub mod two_surface;
 
-use camkit::geom::P3;
 pub use camkit::geom::Region;
+use camkit::geom::{P3, V3};
 use camkit::model::Model;
+use camkit::model::cutter::Cutter;
+use camkit::model::drop::DropCutter;
 use curve::{ClPoint, Steps, Stylus};
 use rayon::prelude::*;
 
@@ -103,15 +105,19 @@ pub struct Options {
 pub fn trace(model: &Model, opts: &Options, tick: &(dyn Fn() + Sync)) -> Result<Vec<TracedPath>, Failure> {
     let (stylus, steps) = (opts.stylus, &opts.steps);
     let nested: Vec<Vec<TracedPath>> = match &opts.mode {
-        Mode::Scan(s) => scan::lines(s)
-            .par_iter()
-            .enumerate()
-            .map(|(k, line)| {
-                let r = scan::trace_line(model, stylus, steps, line, k);
-                tick();
-                r
-            })
-            .collect::<Result<_, _>>()?,
+        Mode::Scan(s) => {
+            // The exact ball drop where every surface has one (starts of drops, see scan.rs).
+            let exact = DropCutter::new(model, Cutter::Ball { radius: stylus.radius }, V3::z()).ok();
+            scan::lines(s)
+                .par_iter()
+                .enumerate()
+                .map(|(k, line)| {
+                    let r = scan::trace_line(model, exact.as_ref(), stylus, steps, line, k);
+                    tick();
+                    r
+                })
+                .collect::<Result<_, _>>()?
+        }
         Mode::Contour { region, levels } => levels
             .par_iter()
             .enumerate()
