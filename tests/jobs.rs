@@ -357,7 +357,7 @@ fn bad_jobs_are_refused_naming_the_field() {
             SETUP.replace(r#""clearance_height": 25"#, r#""clearance_height": -2"#),
             "setup.json:2:73 (clearance_height): clearance_height -2 is below the stock top 0",
         ),
-        ("tool.json", TOOL.replace(r#", "number": 7"#, ""), "tool.json (number): the tool has no `number`"),
+        ("tool.json", TOOL.replace(r#", "number": 7"#, ""), "tool.json:1:1 (number): the tool has no `number`"),
         (
             "passes.csv",
             passes().replacen("0,rapid,4,4,-6", "0,rapid,48,30,-6", 1),

@@ -126,8 +126,13 @@ fn load_machine(args: &Args) -> Result<(Machine, Chain)> {
 /// and the setup's coolant.
 fn with_job(mut machine: Machine, job: &Job) -> Result<Machine> {
     let Some(number) = job.tool.number else {
-        return Err(Error::input("the tool has no `number`: the program needs it for T and H")
-            .at(Location::file(&job.tool_file).field("number")));
+        let e = Error::input("the tool has no `number`: the program needs it for T and H")
+            .at(Location::file(&job.tool_file).field("number"));
+        // Where the tool's object begins (the field is missing): file:line:col as for any value.
+        return Err(match camkit::io::Input::open(&job.tool_file) {
+            Ok(input) => camkit::json::at_value(&input, e),
+            Err(_) => e,
+        });
     };
     machine.program.tool = Some(number);
     machine.program.spindle_speed = job.tool.spindle_speed;
