@@ -1156,6 +1156,11 @@ fn fixed_axis_bad_input() {
     go(&["sphere.json", "--tool", "ball.json", "--mode", "contour"]).fails(2, "--mode scan only");
     go(&["sphere.json", "--tool", "ball.json", "--axis", "0,0,0"]).fails(2, "--axis must be a nonzero direction");
     go(&["sphere.json", "--tool", "ball.json", "--region=20,30,20,30"]).fails(2, "misses the model");
+    // Coordinates where round-off exceeds the contact tolerance, given or from the model.
+    go(&["sphere.json", "--tool", "ball.json", "--region=-1e300,1e300,-1,1"])
+        .fails(2, "sphere.json: the area the cutter drops onto within --region reaches 1e300 mm");
+    w.write("far.json", r#"{"surfaces": [{"type": "sphere", "centre": [1e13, 0, 0], "radius": 10}]}"#);
+    go(&["far.json", "--tool", "ball.json"]).fails(2, "within the model's bounding box (the default --region) reaches");
     assert!(!w.exists("out.csv"));
 }
 

@@ -54,6 +54,15 @@ pub fn run(args: &Args, tool_path: &str, model: &Model, input: &Input, started: 
             Region { x0: b.min.x, x1: b.max.x, y0: b.min.y, y1: b.max.y }
         }
     };
+    // As in the stylus's modes: positions far out lose the bits the exact drops rely on.
+    let source = if args.region.is_some() { "--region" } else { "the model's bounding box (the default --region)" };
+    let b = dc.bounds();
+    let heights = if b.is_bounded() { [b.min.z, b.max.z] } else { [0.0, 0.0] };
+    budget::check_round_off(
+        &[region.x0, region.x1, region.y0, region.y1, heights[0], heights[1], cutter.radius()],
+        positive(args.contact_tol, "--contact-tol")?,
+        &format!("{}: the area the cutter drops onto within {source}", input.name),
+    )?;
     if !(args.angle.is_finite() && args.angle.abs() <= 360.0) {
         return Err(usage(format!("--angle must be a number of degrees from -360 to 360, got {}", args.angle)));
     }
