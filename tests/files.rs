@@ -99,34 +99,6 @@ fn bad_paths_are_bad_input() {
         .fails(2, "Not a directory");
 }
 
-/// With standard output closed (`>&-`) the output cannot be delivered: one line, exit 2, where
-/// `>/dev/null` still discards it quietly.
-#[test]
-fn a_closed_stdout_is_refused() {
-    let w = Work::new();
-    w.write("square.csv", SQUARE);
-    let offset = bin("offset");
-    let sh = |redirect: &str| {
-        Command::new("sh")
-            .current_dir(w.path(""))
-            .arg("-c")
-            .arg(format!("\"$0\" square.csv --radius 1 --side left {redirect}"))
-            .arg(&offset)
-            .output()
-            .unwrap()
-    };
-    let closed = sh(">&-");
-    let err = String::from_utf8_lossy(&closed.stderr);
-    assert_eq!((closed.status.code(), err.lines().count()), (Some(2), 1), "{err}");
-    assert!(err.contains("cannot write stdout: it is closed"), "{err}");
-    let discarded = sh(">/dev/null");
-    assert_eq!((discarded.status.code(), discarded.stderr.len()), (Some(0), 0));
-    // Output to a file with stdout closed is unaffected.
-    let to_file = sh("-o out.csv >&-");
-    assert_eq!(to_file.status.code(), Some(0));
-    assert!(w.read("out.csv").starts_with("path,"), "{}", w.read("out.csv"));
-}
-
 /// Old Mac line ends after a comment, lines of spaces and a byte order mark read like the plain
 /// table; a G-code file after a byte order mark reads like the plain one.
 #[test]

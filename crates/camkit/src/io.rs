@@ -179,10 +179,7 @@ impl Stream {
                 written: 0,
             })
         };
-        let Some(path) = path else {
-            refuse_closed_stdout()?;
-            return unnamed(shown.clone(), None);
-        };
+        let Some(path) = path else { return unnamed(shown.clone(), None) };
         let path = follow_links(path).map_err(cannot)?;
         let existing = std::fs::metadata(&path).ok();
         if existing.as_ref().is_some_and(|m| !m.is_file() && !m.is_dir()) {
@@ -255,24 +252,6 @@ impl Stream {
     }
 }
 
-/// Refuses standard output when it was closed as the program started (`>&-`): the Rust runtime
-/// then puts /dev/null opened read-write in its place, and the output would be lost with exit 0.
-/// A shell's `>/dev/null` opens it write-only, so that stays a quiet way to discard the output.
-fn refuse_closed_stdout() -> Result<()> {
-    let on_null = std::fs::read_link("/proc/self/fd/1").is_ok_and(|p| p == Path::new("/dev/null"));
-    let read_write = || {
-        std::fs::read_to_string("/proc/self/fdinfo/1").is_ok_and(|info| {
-            info.lines()
-                .filter_map(|l| l.strip_prefix("flags:"))
-                .any(|f| u32::from_str_radix(f.trim(), 8).is_ok_and(|f| f & 0o3 == 0o2))
-        })
-    };
-    if on_null && read_write() {
-        return Err(Error::input("cannot write stdout: it is closed (give -o FILE, or >/dev/null to discard)"));
-    }
-    Ok(())
-}
-
 /// A temporary file registered for [`remove_pending`] until it is dropped (and deleted) or taken.
 #[derive(Debug)]
 struct Registered(Option<tempfile::TempPath>);
@@ -330,7 +309,6 @@ impl Output {
         match &self.path {
             Some(path) => write_atomic(path, &self.buf),
             None => {
-                refuse_closed_stdout()?;
                 let mut out = std::io::stdout().lock();
                 out.write_all(&self.buf).and_then(|_| out.flush()).map_err(|e| Error::io(e, "stdout"))
             }
