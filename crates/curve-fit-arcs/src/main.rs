@@ -4,11 +4,12 @@ use camkit::cli::{self, IoArgs, Kind, positive};
 use camkit::contour::load::{ContourArgs, InputKind};
 use camkit::error::{Error, Location, Result};
 use camkit::geom::Plane;
-use camkit::io::{Input, Output, Source, Stream, write_atomic};
+use camkit::io::{Input, Output, Restart, Source, Stream, write_atomic};
 use camkit::report::Report;
 use camkit::table::{self, Col, WriteOptions};
 use clap::{Parser, ValueEnum};
 use curve_fit_arcs::gcode_runs::{self, ProgramError};
+use curve_fit_arcs::table_runs::{Fitter, Written};
 use curve_fit_arcs::{Method, Options, Stats, Sweep, plot, table_runs};
 use std::io::BufRead;
 use std::path::PathBuf;
@@ -165,6 +166,9 @@ fn run(args: Args) -> Result<()> {
     if from == Kind::Gcode && to == Kind::Gcode {
         return run_gcode(&args, &opts);
     }
+    if from == Kind::Table && to == Kind::Table {
+        return run_table(&args, &opts, &contour_opts);
+    }
     let started = Instant::now();
     let mut input = Input::open(&args.io.input)?;
     let bytes_in = input.data.len();
@@ -185,33 +189,82 @@ fn run(args: Args) -> Result<()> {
         fit_to_table(&t, &opts, &args, &input, &mut out)?
     } else {
         let (t, skipped) = camkit::contour::load::table(&input, &contour_opts)?;
-        if let Some((kind, line)) = skipped.first() {
-            cli::warn(&format!(
-                "{}: {} drawing entities that are not contours skipped (the first: {kind} at line {line})",
-                input.name,
-                skipped.len()
-            ));
-        }
+        warn_skipped(&input.name, &skipped);
         let distinct = t.rows.windows(2).filter(|w| (w[0].pos - w[1].pos).norm() > camkit::tol::POINT_EPS).count() + 1;
         if t.rows.is_empty() || distinct < 2 {
             let what = if t.rows.is_empty() { "no points" } else { "a single point" };
             return Err(Error::input(format!("{what}: at least two distinct points are needed"))
                 .at(Location::file(&input.name)));
         }
-        if to == Kind::Gcode {
-            let d = args.decimals.unwrap_or(4);
-            let (fitted, stats, runs) = table_runs::fit_table(&t, &opts, Some(d))
-                .map_err(|e| unfittable(&input.name, e.line, e.cause.deviation, &opts))?;
-            out.buf = camkit::gcode::table_to_program(&fitted, &input.name, d)?;
-            (stats, runs)
-        } else {
-            fit_to_table(&t, &opts, &args, &input, &mut out)?
-        }
+        let d = args.decimals.unwrap_or(4);
+        let (fitted, stats, runs) = table_runs::fit_table(&t, &opts, Some(d))
+            .map_err(|e| unfittable(&input.name, e.line, e.cause.deviation, &opts))?;
+        out.buf = camkit::gcode::table_to_program(&fitted, &input.name, d)?;
+        (stats, runs)
     };
     progress.finish();
     let bytes_out = out.buf.len();
     finish(&args, &opts, &input.name, &stats, &runs, started, bytes_in, bytes_out)?;
     out.commit()
+}
+
+/// Table to table, streamed: rows read, fitted run by run and written as they come, never the
+/// table held as rows (only the input's text). The header depends on what the fit writes (centre
+/// columns for arcs, plane columns for arcs off XY): it is guessed (arcs, all in XY) and the table
+/// is fitted and written again, with the right header, in the rare run where that was wrong.
+fn run_table(args: &Args, opts: &Options, contours: &camkit::contour::load::Options) -> Result<()> {
+    let started = Instant::now();
+    let input = Input::open(&args.io.input)?;
+    let mut out = Stream::new(args.io.output.as_deref())?;
+    let progress = args.io.progress(0, "fitting arcs");
+    let keep_runs = args.svg.is_some() || args.lower_bound;
+    let wopts = WriteOptions { decimals: args.decimals };
+    let mut guess = Written { arcs: true, other_planes: false };
+    for pass in 0.. {
+        let mut fitter = Fitter::new(opts, args.decimals, keep_runs);
+        let mut writer: Option<table::RowWriter> = None;
+        let (mut rows, mut moved, mut last) = (0usize, false, None::<camkit::geom::P3>);
+        let (schema, skipped) = camkit::contour::load::table_each(&input, contours, |schema, row| {
+            rows += 1;
+            moved |= last.is_some_and(|p| (p - row.pos).norm() > camkit::tol::POINT_EPS);
+            last = Some(row.pos);
+            fitter.push(row).map_err(|e| unfittable(&input.name, e.line, e.cause.deviation, opts))?;
+            let w = writer.get_or_insert_with(|| table::RowWriter::new(&guess.schema(schema), wopts));
+            fitter.ready.drain(..).try_for_each(|r| w.row(&mut out, &r))
+        })?;
+        if pass == 0 {
+            warn_skipped(&input.name, &skipped);
+        }
+        if !moved {
+            let what = if rows == 0 { "no points" } else { "a single point" };
+            return Err(Error::input(format!("{what}: at least two distinct points are needed"))
+                .at(Location::file(&input.name)));
+        }
+        fitter.flush().map_err(|e| unfittable(&input.name, e.line, e.cause.deviation, opts))?;
+        let mut w = writer.expect("rows were read");
+        fitter.ready.drain(..).try_for_each(|r| w.row(&mut out, &r))?;
+        w.finish(&mut out)?;
+        let (stats, runs, written) = fitter.into_results();
+        if written.schema(&schema) != guess.schema(&schema) {
+            guess = written;
+            out.restart().map_err(|e| Error::io(e, "output"))?;
+            continue;
+        }
+        progress.finish();
+        finish(args, opts, &input.name, &stats, &runs, started, input.data.len(), out.len() as usize)?;
+        return out.commit();
+    }
+    unreachable!("the second pass writes the header the first one found")
+}
+
+/// Warns of a drawing's entities that are not contours.
+fn warn_skipped(name: &str, skipped: &[(String, u64)]) {
+    if let Some((kind, line)) = skipped.first() {
+        cli::warn(&format!(
+            "{name}: {} drawing entities that are not contours skipped (the first: {kind} at line {line})",
+            skipped.len()
+        ));
+    }
 }
 
 /// G-code to G-code, streamed: read, fitted and written run by run, never the whole program in

@@ -142,6 +142,21 @@ pub fn contours(input: &Input, opts: &Options) -> Result<Loaded> {
 /// a `line`, `cw` or `ccw` row per piece; every row on its contour's first line in the drawing),
 /// so that a filter made for tables takes drawings too. G-code is the caller's to read.
 pub fn table(input: &Input, opts: &Options) -> Result<(table::Table, Vec<(String, u64)>)> {
+    let mut rows = Vec::new();
+    let (schema, skipped) = table_each(input, opts, |_, row| {
+        rows.push(row);
+        Ok(())
+    })?;
+    Ok((table::Table { schema, rows }, skipped))
+}
+
+/// [`table`] row by row: each row goes to `on_row` as it is read (a table file is never held as
+/// rows; a drawing is small and made whole first); returns the schema and what was skipped.
+pub fn table_each(
+    input: &Input,
+    opts: &Options,
+    mut on_row: impl FnMut(&table::Schema, table::Row) -> Result<()>,
+) -> Result<(table::Schema, Vec<(String, u64)>)> {
     let kind = opts.from.resolve(input);
     let read = match kind {
         InputKind::Dxf => crate::dxf::read(&input.name, &String::from_utf8_lossy(&input.data), &opts.drawing)?,
@@ -154,8 +169,8 @@ pub fn table(input: &Input, opts: &Options) -> Result<(table::Table, Vec<(String
             .at(Location::file(&input.name)));
         }
         _ => {
-            return table::read(input, &[Col::X, Col::Y])
-                .map(|t| (t, Vec::new()))
+            return table::read_each(input, &[Col::X, Col::Y], on_row)
+                .map(|schema| (schema, Vec::new()))
                 .map_err(|e| sniffed(input, opts.gcode).unwrap_or(e));
         }
     };
@@ -173,7 +188,11 @@ pub fn table(input: &Input, opts: &Options) -> Result<(table::Table, Vec<(String
         return Err(Error::input(format!("no closed contour in the drawing{on}: it needs {has}"))
             .at(Location::file(&input.name)));
     }
-    Ok((drawing_table(&read.sources), read.skipped))
+    let t = drawing_table(&read.sources);
+    for row in t.rows {
+        on_row(&t.schema, row)?;
+    }
+    Ok((t.schema, read.skipped))
 }
 
 /// A drawing's contours as the toolpath table.

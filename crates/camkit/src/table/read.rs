@@ -21,6 +21,22 @@ impl Layout {
 
 /// Reads a whole table from `input`. `required` columns must be in the header.
 pub fn read(input: &Input, required: &[Col]) -> Result<Table> {
+    let mut rows = Vec::new();
+    let schema = read_each(input, required, |_, row| {
+        rows.push(row);
+        Ok(())
+    })?;
+    Ok(Table { schema, rows })
+}
+
+/// Reads `input` row by row, handing each row to `on_row` as it is parsed (with the schema), so
+/// that a filter working run by run need not hold the table's rows; returns the schema. An error
+/// of `on_row` stops the reading and is returned.
+pub fn read_each(
+    input: &Input,
+    required: &[Col],
+    mut on_row: impl FnMut(&Schema, Row) -> Result<()>,
+) -> Result<Schema> {
     let data = normalise(&input.data);
     let mut reader =
         csv::ReaderBuilder::new().comment(Some(b'#')).trim(csv::Trim::All).flexible(false).from_reader(&data[..]);
@@ -38,7 +54,6 @@ pub fn read(input: &Input, required: &[Col]) -> Result<Table> {
             return Err(Error::input(format!("missing column `{}`", columns::spec(col).name)).at(loc(header_line)));
         }
     }
-    let mut rows = Vec::new();
     let mut record = csv::ByteRecord::new();
     loop {
         match reader.read_byte_record(&mut record) {
@@ -47,9 +62,9 @@ pub fn read(input: &Input, required: &[Col]) -> Result<Table> {
             Err(e) => return Err(csv_error(e, &input.name, &mut lines)),
         }
         let line = record.position().map_or(0, |p| lines.at(p.byte()));
-        rows.push(parse_row(&record, &layout, &schema, &input.name, line)?);
+        on_row(&schema, parse_row(&record, &layout, &schema, &input.name, line)?)?;
     }
-    Ok(Table { schema, rows })
+    Ok(schema)
 }
 
 /// The text with old Mac line ends (a lone CR) made LF and lines of only spaces and tabs made

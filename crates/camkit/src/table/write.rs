@@ -26,15 +26,15 @@ pub fn write(out: &mut dyn Write, table: &Table, opts: &WriteOptions) -> Result<
 
 /// A table written row by row as the rows are made, so that they need not be held: the header
 /// first, then each row, through a buffer of 64 kB.
-pub struct RowWriter<'a> {
-    schema: &'a Schema,
+pub struct RowWriter {
+    schema: Schema,
     opts: WriteOptions,
     buf: Vec<u8>,
 }
 
-impl<'a> RowWriter<'a> {
+impl RowWriter {
     /// A writer of rows of `schema`, its header buffered.
-    pub fn new(schema: &'a Schema, opts: WriteOptions) -> RowWriter<'a> {
+    pub fn new(schema: &Schema, opts: WriteOptions) -> RowWriter {
         let mut buf: Vec<u8> = Vec::with_capacity(1 << 16);
         for (n, field) in schema.fields.iter().enumerate() {
             if n > 0 {
@@ -46,7 +46,7 @@ impl<'a> RowWriter<'a> {
             }
         }
         buf.push(b'\n');
-        RowWriter { schema, opts, buf }
+        RowWriter { schema: schema.clone(), opts, buf }
     }
 
     /// Writes one row (to `out` once the buffer is full).
