@@ -346,3 +346,29 @@ fn streamed_program_is_the_same_from_file_stdin_and_to_a_file() {
     assert!(!w.exists("bad.nc"));
     assert!(!w.files().iter().any(|f| f.contains(".camkit-")), "{:?}", w.files());
 }
+
+/// A table is fitted run by run as it is read; the header is known only after the fit (centre
+/// columns, plane columns for arcs off XY), so the streamed writer rewrites it when its guess
+/// was wrong: a half circle in XZ after a straight run comes out with `zc,plane`, centred.
+#[test]
+fn streamed_table_header_follows_the_arcs_written() {
+    let mut input = String::from("path,x,y,z\n");
+    for i in 0..=10 {
+        input.push_str(&format!("0,{},0,0\n", -20.0 + i as f64));
+    }
+    for i in 0..=60 {
+        let t = std::f64::consts::PI * i as f64 / 60.0;
+        input.push_str(&format!("1,{:.9},0,{:.9}\n", 10.0 * t.cos(), 10.0 * t.sin()));
+    }
+    let w = Work::new();
+    let out = w.run(BIN, &["-", "--plane", "auto", "--tol", "0.01"], input.as_bytes()).ok();
+    let mut lines = out.lines();
+    assert_eq!(lines.next(), Some("path,move,x,y,z,xc,yc,zc,plane"));
+    let arcs: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect::<Vec<_>>()).filter(|f| f[1] != "line").collect();
+    assert!(!arcs.is_empty());
+    for f in &arcs {
+        assert_eq!(f[8], "xz", "{f:?}");
+        let (xc, zc): (f64, f64) = (f[5].parse().unwrap(), f[7].parse().unwrap());
+        assert!(xc.abs() < 1e-6 && zc.abs() < 1e-6, "centre ({xc}, {zc})");
+    }
+}
