@@ -57,7 +57,7 @@ for spec in 10:2000 50:2000 105:2000 50:50000; do
   before=-; [ -n "$BEFORE" ] && { before=$(peak "$BEFORE/curve-fit-arcs" "$f" --tol 0.01); cmp -s "$DIR/out" <("$BIN/curve-fit-arcs" "$f" --tol 0.01) || before="$before (output differs!)"; }
   echo "| curve-fit-arcs G-code → G-code, runs of $RUN moves | $(size_mb "$f") MB | $out MB | $before | $after |"
 done
-# A table of about 50 MB: the same ripple arcs as points, one path per run (not streamed yet).
+# A table of about 50 MB: the same ripple arcs as points, one path per run.
 if [ ! -s "$DIR/pts-50mb.csv" ]; then
   python3 - > "$DIR/pts-50mb.csv" <<'PY'
 import math, sys
@@ -79,7 +79,7 @@ f=$DIR/pts-50mb.csv
 after=$(peak "$BIN/curve-fit-arcs" "$f")
 out=$(size_mb "$DIR/out")
 before=-; [ -n "$BEFORE" ] && { before=$(peak "$BEFORE/curve-fit-arcs" "$f"); cmp -s "$DIR/out" <("$BIN/curve-fit-arcs" "$f") || before="$before (output differs!)"; }
-echo "| curve-fit-arcs table → table, runs of 2000 rows (read whole) | $(size_mb "$f") MB | $out MB | $before | $after |"
+echo "| curve-fit-arcs table → table, runs of 2000 rows | $(size_mb "$f") MB | $out MB | $before | $after |"
 for spec in "0,670 0,670" "0,2080 0,2080"; do
   set -- $spec
   step=1
