@@ -600,3 +600,53 @@ fn the_stylus_radius_recorded_in_the_stream_must_be_the_balls() {
     let t = Rows::parse(&out);
     assert!(t.rows.iter().all(|r| r[t.cols["point"]] == "tip") && !t.cols.contains_key("stylus_radius"));
 }
+
+/// `--axis` streams the table in chunks of 16 384 rows: 40 000 stylus centres over a floor, the
+/// last 5 000 sunk 0.5 mm into it, give every tip 3 below its centre, the gouges from the first
+/// sunk row (named by its line) on, and the same table whatever the thread count.
+#[test]
+fn fixed_axis_streams_across_chunks() {
+    let w = Work::new();
+    w.write("floor.json", r#"{"surfaces": [{"type": "plane", "point": [0, 0, 0], "normal": [0, 0, 1]}]}"#);
+    w.write("ball.json", r#"{"kind": "ball", "radius": 3, "length": 20}"#);
+    let mut cl = String::from("path,x,y,z,point,stylus_radius\n");
+    for k in 0..40_000 {
+        let z = if k >= 35_000 { 2.5 } else { 3.0 };
+        cl.push_str(&format!("{},{},{},{z},stylus-centre,3\n", k / 1000, (k % 1000) as f64 * 0.1, k / 1000));
+    }
+    w.write("cl.csv", &cl);
+    let args = ["cl.csv", "--tool", "ball.json", "--axis", "0,0,1", "--model", "floor.json", "--allow-gouge"];
+    let run = |threads: &str| {
+        std::process::Command::new(e2e::bin(BIN))
+            .args(args)
+            .args(["--report", "r.json"])
+            .current_dir(w.path(""))
+            .env("RAYON_NUM_THREADS", threads)
+            .output()
+            .expect("run")
+    };
+    let (one, three) = (run("1"), run("3"));
+    assert_eq!(one.stdout, three.stdout);
+    let stderr = String::from_utf8_lossy(&three.stderr);
+    assert!(stderr.contains("cl.csv:35002: 5000 row(s) gouge the model"), "{stderr}");
+    let out = String::from_utf8(three.stdout).unwrap();
+    let lines: Vec<&str> = out.lines().collect();
+    assert_eq!(lines[0], "path,x,y,z,i,j,k,point,gouge");
+    assert_eq!(lines.len(), 40_001);
+    for (k, line) in lines[1..].iter().enumerate() {
+        let f: Vec<&str> = line.split(',').collect();
+        let (z, gouge): (f64, f64) = (f[3].parse().unwrap(), f[8].parse().unwrap());
+        let sunk = k >= 35_000;
+        assert_eq!(z, if sunk { -0.5 } else { 0.0 }, "row {k}");
+        assert!((gouge - if sunk { 0.5 } else { 0.0 }).abs() < 1e-6, "row {k}: gouge {gouge}");
+        assert_eq!(f[7], "tip");
+    }
+    let r: serde_json::Value = serde_json::from_str(&w.read("r.json")).unwrap();
+    assert_eq!(
+        (r["rows"].as_u64(), r["paths"].as_u64(), r["gouge_rows"].as_u64()),
+        (Some(40_000), Some(40), Some(5000))
+    );
+    // Without --allow-gouge: exit 1 naming the first sunk row, no output.
+    w.run(BIN, &[&args[..7], &["-o", "t.csv"]].concat(), b"").fails(1, "cl.csv:35002: 5000 row(s) gouge");
+    assert!(!w.exists("t.csv"));
+}

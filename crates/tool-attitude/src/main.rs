@@ -5,7 +5,7 @@ use camkit::cli::{self, IoArgs};
 use camkit::doc::{Tool, ToolKind};
 use camkit::error::{Error, Location, Result};
 use camkit::geom::{P3, V3};
-use camkit::io::{Input, Output, write_atomic};
+use camkit::io::{Input, Output, Stream, write_atomic};
 use camkit::json::{at_value, field_error};
 use camkit::model::Model;
 use camkit::report::Report;
@@ -306,7 +306,9 @@ fn fixed_axis(text: &str) -> Result<V3> {
     Ok(v / n)
 }
 
-/// `--axis`: tips of a ball end mill on a fixed axis from the stylus centres.
+/// `--axis`: tips of a ball end mill on a fixed axis from the stylus centres, streamed: rows are
+/// read, placed (in parallel, [`CHUNK`] rows at a time) and written as they come, never the table
+/// held as rows (but with --svg, which draws them all).
 fn run_fixed(args: &Args, tool: &Tool, tool_file: &str, axis: V3, started: Instant) -> Result<()> {
     if tool.kind != ToolKind::Ball {
         return Err(field_error(
@@ -316,52 +318,43 @@ fn run_fixed(args: &Args, tool: &Tool, tool_file: &str, axis: V3, started: Insta
         ));
     }
     let input = Input::open(&args.io.input)?;
-    let mut t = table::read(&input, &[Col::X, Col::Y, Col::Z])?;
-    if t.rows.is_empty() {
-        return Err(Error::input("no rows").at(Location::file(&input.name)));
-    }
-    if t.schema.extra_index(meaning::POINT).is_some() && meaning::of(&t, &input.name)? == Meaning::Tip {
-        return Err(Error::input(
-            "the stream's rows are tool tips already (`point` = tip): --axis takes the stylus centres stylus-trace -r writes",
-        )
-        .at(Location::file(&input.name)));
-    }
-    check_stylus(&t, &input.name, tool, tool_file)?;
     let r = tool.radius;
     let length = tool.length.unwrap_or(4.0 * r);
     let part = load_part(args, tool, length)?;
-    t.schema.add(&[Col::I, Col::J, Col::K]);
-    let c_gouge = part.is_some().then(|| t.add_extra_column("gouge"));
-    let progress = args.io.progress(t.rows.len() as u64, "placing tips");
-    let gouges: Vec<f64> = t
-        .rows
-        .par_iter()
-        .map(|row| {
-            let tip = tool_attitude::fixed_axis_ball_tip(&row.pos, &axis, r);
-            let gouge =
-                part.as_ref().map_or(0.0, |p| p.penetration(&tool_attitude::pose::Pose { tip, axis, edge: None }));
-            progress.inc(1);
-            gouge
-        })
-        .collect();
-    progress.finish();
-    let num = |v: f64| {
-        let mut b = Vec::new();
-        camkit::num::push_shortest(&mut b, v);
-        String::from_utf8(b).expect("ascii")
-    };
-    let mut gouging = Vec::new();
-    for (k, (row, g)) in t.rows.iter_mut().zip(&gouges).enumerate() {
-        row.pos = tool_attitude::fixed_axis_ball_tip(&row.pos, &axis, r);
-        row.axis = axis;
-        if let Some(i) = c_gouge {
-            row.extra[i] = num(*g);
-            if *g > args.gouge_tol {
-                gouging.push(k);
+    let mut out = Stream::new(args.io.output.as_deref())?;
+    let progress = args.io.progress(0, "placing tips");
+    let mut placed = Placed { kept: args.svg.is_some().then(Vec::new), ..Placed::default() };
+    let mut stream: Option<FixedStream> = None;
+    let mut chunk = Vec::with_capacity(CHUNK);
+    table::read_each(&input, &[Col::X, Col::Y, Col::Z], |schema, row| {
+        let s = match &mut stream {
+            Some(s) => s,
+            None => stream.insert(FixedStream::new(schema, part.is_some(), args.decimals)),
+        };
+        s.check.row(&row, &input.name)?;
+        if placed.rows == 0 {
+            if s.check.says() && s.check.meaning() == Meaning::Tip {
+                return Err(Error::input(
+                    "the stream's rows are tool tips already (`point` = tip): --axis takes the stylus centres stylus-trace -r writes",
+                )
+                .at(Location::file(&input.name)));
             }
+            check_stylus(s.check.meaning(), &input.name, tool, tool_file)?;
         }
-    }
-    let largest = gouges.iter().copied().fold(0.0, f64::max);
+        placed.rows += 1;
+        chunk.push(row);
+        if chunk.len() == CHUNK {
+            s.place(&mut chunk, &axis, r, part.as_ref(), args.gouge_tol, &mut placed, &mut out)?;
+            progress.inc(CHUNK as u64);
+        }
+        Ok(())
+    })?;
+    let Some(mut s) = stream else {
+        return Err(Error::input("no rows").at(Location::file(&input.name)));
+    };
+    s.place(&mut chunk, &axis, r, part.as_ref(), args.gouge_tol, &mut placed, &mut out)?;
+    s.writer.finish(&mut out)?;
+    progress.finish();
     let mut report = Report::new("tool-attitude");
     if let Some(m) = part.as_ref().map(|p| &p.model) {
         let (degenerate, duplicate) = m.dropped_counts();
@@ -370,17 +363,111 @@ fn run_fixed(args: &Args, tool: &Tool, tool_file: &str, axis: V3, started: Insta
     report
         .set("tool", tool)
         .set("fixed_axis", [axis.x, axis.y, axis.z])
-        .set("rows", t.rows.len())
-        .set("paths", t.passes().count())
-        .set("gouge_rows", gouging.len())
+        .set("rows", placed.rows)
+        .set("paths", placed.paths)
+        .set("gouge_rows", placed.gouge_rows)
         .set("gouge_tol_mm", args.gouge_tol)
-        .set("largest_gouge_mm", largest)
+        .set("largest_gouge_mm", placed.largest)
         .set("gouge_chord_mm", part.as_ref().map(Part::chord_error))
         .set("seconds", started.elapsed().as_secs_f64());
     if let Some(path) = &args.io.report {
         report.write(path)?;
     }
-    deliver(args, &mut t, &input.name, part.as_ref().map(|p| &p.model), &gouging, args.gouge_tol, largest)
+    let model = part.as_ref().map(|p| &p.model);
+    let gouging = placed.first_gouge.map(|line| (line, placed.gouge_rows));
+    refuse_gouges(args, &input.name, gouging, args.gouge_tol, placed.largest)?;
+    if let (Some(path), Some(rows)) = (&args.svg, placed.kept) {
+        let t = Table { schema: s.marker.schema.clone(), rows };
+        plot(path, &t, &input.name, model)?;
+    }
+    out.commit()
+}
+
+/// Rows placed at a time by the fixed-axis stream (in parallel within a chunk).
+const CHUNK: usize = 1 << 14;
+
+/// The fixed-axis stream's output: the meaning check, the columns added and the writer.
+struct FixedStream {
+    check: meaning::Check,
+    gouge: Option<usize>,
+    marker: meaning::TipMarker,
+    writer: table::RowWriter,
+}
+
+/// What the fixed-axis stream has placed so far.
+#[derive(Default)]
+struct Placed {
+    rows: usize,
+    paths: usize,
+    last_path: Option<i64>,
+    gouge_rows: usize,
+    first_gouge: Option<u64>,
+    largest: f64,
+    /// The rows written, for --svg.
+    kept: Option<Vec<table::Row>>,
+}
+
+impl FixedStream {
+    fn new(schema: &table::Schema, gouge: bool, decimals: Option<u32>) -> FixedStream {
+        let mut out = schema.clone();
+        out.add(&[Col::I, Col::J, Col::K]);
+        let gouge = gouge.then(|| out.add_extra("gouge"));
+        let marker = meaning::TipMarker::new(&out);
+        let writer = table::RowWriter::new(&marker.schema, WriteOptions { decimals });
+        FixedStream { check: meaning::Check::new(schema), gouge, marker, writer }
+    }
+
+    /// Places the rows of `chunk` (emptied): tips and, with a part, their gouges (in parallel),
+    /// then writes them in order.
+    #[allow(clippy::too_many_arguments)]
+    fn place(
+        &mut self,
+        chunk: &mut Vec<table::Row>,
+        axis: &V3,
+        r: f64,
+        part: Option<&Part>,
+        gouge_tol: f64,
+        placed: &mut Placed,
+        out: &mut Stream,
+    ) -> Result<()> {
+        let gouges: Vec<f64> = chunk
+            .par_iter()
+            .map(|row| {
+                let tip = tool_attitude::fixed_axis_ball_tip(&row.pos, axis, r);
+                part.map_or(0.0, |p| p.penetration(&tool_attitude::pose::Pose { tip, axis: *axis, edge: None }))
+            })
+            .collect();
+        for (mut row, g) in chunk.drain(..).zip(gouges) {
+            if placed.last_path != Some(row.path) {
+                placed.paths += 1;
+                placed.last_path = Some(row.path);
+            }
+            row.pos = tool_attitude::fixed_axis_ball_tip(&row.pos, axis, r);
+            row.axis = *axis;
+            if let Some(i) = self.gouge {
+                row.extra.resize(i + 1, String::new());
+                row.extra[i] = num(g);
+                if g > gouge_tol {
+                    placed.gouge_rows += 1;
+                    placed.first_gouge.get_or_insert(row.line);
+                }
+            }
+            placed.largest = placed.largest.max(g);
+            self.marker.row(&mut row);
+            self.writer.row(out, &row)?;
+            if let Some(kept) = &mut placed.kept {
+                kept.push(row);
+            }
+        }
+        Ok(())
+    }
+}
+
+/// The shortest text of `v` that reads back exactly.
+fn num(v: f64) -> String {
+    let mut b = Vec::new();
+    camkit::num::push_shortest(&mut b, v);
+    String::from_utf8(b).expect("ascii")
 }
 
 fn run(args: Args) -> Result<()> {
@@ -407,7 +494,8 @@ fn run(args: Args) -> Result<()> {
             .at(Location::file(&input.name)));
     }
     if tool.kind == ToolKind::Ball {
-        check_stylus(&t, &input.name, &tool, &tool_input.name).map_err(|e| at_value(&tool_input, e))?;
+        check_stylus(meaning::of(&t, &input.name)?, &input.name, &tool, &tool_input.name)
+            .map_err(|e| at_value(&tool_input, e))?;
     }
     let needs_second = matches!(setup.shape, Shape::FlatType { .. });
     let cs = contacts(&t, &input.name, model, needs_second)?;
@@ -457,11 +545,6 @@ fn run(args: Args) -> Result<()> {
         matches!(setup.shape, Shape::FlatMill { .. }).then(|| (t.add_extra_column("ac_a"), t.add_extra_column("ac_c")));
     let c_gap = needs_second.then(|| t.add_extra_column("flank_gap"));
     let c_gouge = part.is_some().then(|| t.add_extra_column("gouge"));
-    let num = |v: f64| {
-        let mut b = Vec::new();
-        camkit::num::push_shortest(&mut b, v);
-        String::from_utf8(b).expect("ascii")
-    };
     let mut gouging = Vec::new();
     for (k, (row, a)) in t.rows.iter_mut().zip(&poses).enumerate() {
         row.pos = a.pose.tip;
@@ -542,8 +625,8 @@ fn load_part(args: &Args, tool: &Tool, length: f64) -> Result<Option<Part>> {
 
 /// A ball's centre is the stylus centre only if both have one radius: a stream that records a
 /// stylus of another radius is refused (naming both), one that records none is taken as given.
-fn check_stylus(t: &Table, file: &str, tool: &Tool, tool_file: &str) -> Result<()> {
-    if let Meaning::StylusCentre(rs) = meaning::of(t, file)? {
+fn check_stylus(meaning: Meaning, file: &str, tool: &Tool, tool_file: &str) -> Result<()> {
+    if let Meaning::StylusCentre(rs) = meaning {
         if (rs - tool.radius).abs() > 1e-9 * rs.max(1.0) {
             return Err(field_error(
                 tool_file,
@@ -571,22 +654,35 @@ fn deliver(
     largest: f64,
 ) -> Result<()> {
     meaning::mark_tip(t);
-    if let Some(&k) = gouging.first() {
-        let msg = format!("{} row(s) gouge the model by more than {tol} mm (deepest {largest:.6} mm)", gouging.len());
-        let loc = Location::file(input).line(t.rows[k].line);
+    let first = gouging.first().map(|&k| (t.rows[k].line, gouging.len()));
+    refuse_gouges(args, input, first, tol, largest)?;
+    if let Some(path) = &args.svg {
+        plot(path, t, input, model)?;
+    }
+    let mut out = Output::new(args.io.output.as_deref());
+    table::write(&mut out, t, &WriteOptions { decimals: args.decimals })?;
+    out.commit()
+}
+
+/// Rows that gouge (the first's line and their count, the deepest `largest` mm) fail the run
+/// (exit 1, the first row named) or, with --allow-gouge, are warned of.
+fn refuse_gouges(args: &Args, input: &str, gouging: Option<(u64, usize)>, tol: f64, largest: f64) -> Result<()> {
+    if let Some((line, count)) = gouging {
+        let msg = format!("{count} row(s) gouge the model by more than {tol} mm (deepest {largest:.6} mm)");
+        let loc = Location::file(input).line(line);
         if !args.allow_gouge {
             return Err(Error::check(msg).at(loc));
         }
         cli::warn(&format!("{loc}: {msg}"));
     }
-    if let Some(path) = &args.svg {
-        let title = format!("{input}: {} rows, tool tip and axis", t.rows.len());
-        let under = model.map_or_else(Vec::new, |m| relief::grid_under(m, t.rows.iter().map(|r| &r.pos)));
-        write_atomic(path, tool_attitude::plot::plot(t, &title, &under).to_svg(1200.0).as_bytes())?;
-    }
-    let mut out = Output::new(args.io.output.as_deref());
-    table::write(&mut out, t, &WriteOptions { decimals: args.decimals })?;
-    out.commit()
+    Ok(())
+}
+
+/// The tips and axes of `t` drawn to `path`, over the model's height grid.
+fn plot(path: &std::path::Path, t: &Table, input: &str, model: Option<&Model>) -> Result<()> {
+    let title = format!("{input}: {} rows, tool tip and axis", t.rows.len());
+    let under = model.map_or_else(Vec::new, |m| relief::grid_under(m, t.rows.iter().map(|r| &r.pos)));
+    write_atomic(path, tool_attitude::plot::plot(t, &title, &under).to_svg(1200.0).as_bytes())
 }
 
 /// A pose's measured deviation from its definition above this fails the run (a bug, exit 1).

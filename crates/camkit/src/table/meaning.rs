@@ -4,7 +4,7 @@
 //! `stylus_radius` (mm, on stylus-centre rows). A stream without `point` is taken as tips (hand
 //! made and older streams).
 
-use super::{Field, Table};
+use super::{Field, Row, Schema, Table};
 use crate::error::{Error, Location, Result};
 
 /// Column naming what `x,y,z` is.
@@ -28,15 +28,41 @@ pub enum Meaning {
 /// What `table` (read from `file`) records: every row must say the same; a stylus-centre row
 /// must give its positive radius. Errors name the line and column.
 pub fn of(table: &Table, file: &str) -> Result<Meaning> {
-    let Some(p) = table.schema.extra_index(POINT) else { return Ok(Meaning::Tip) };
-    let r = table.schema.extra_index(STYLUS_RADIUS);
-    let mut first: Option<Meaning> = None;
+    let mut check = Check::new(&table.schema);
     for row in &table.rows {
+        check.row(row, file)?;
+    }
+    Ok(check.meaning())
+}
+
+/// [`of`] row by row, for a stream read as it comes: [`Check::row`] each row, then
+/// [`Check::meaning`].
+#[derive(Clone, Debug)]
+pub struct Check {
+    point: Option<usize>,
+    radius: Option<usize>,
+    first: Option<Meaning>,
+}
+
+impl Check {
+    /// A check of rows of `schema`.
+    pub fn new(schema: &Schema) -> Check {
+        Check { point: schema.extra_index(POINT), radius: schema.extra_index(STYLUS_RADIUS), first: None }
+    }
+
+    /// True when the stream has a `point` column (says what it holds).
+    pub fn says(&self) -> bool {
+        self.point.is_some()
+    }
+
+    /// Checks one row (read from `file`) against the rows before it.
+    pub fn row(&mut self, row: &Row, file: &str) -> Result<()> {
+        let Some(p) = self.point else { return Ok(()) };
         let at = |col: &str| Location::file(file).line(row.line).field(col.to_string());
         let m = match row.extra[p].as_str() {
             TIP => Meaning::Tip,
             STYLUS_CENTRE => {
-                let text = r.map_or("", |i| row.extra[i].as_str());
+                let text = self.radius.map_or("", |i| row.extra[i].as_str());
                 let radius = text.parse::<f64>().ok().filter(|v| v.is_finite() && *v > 0.0).ok_or_else(|| {
                     Error::input(format!("a stylus-centre row needs its stylus radius (mm), got {text:?}"))
                         .at(at(STYLUS_RADIUS))
@@ -49,8 +75,8 @@ pub fn of(table: &Table, file: &str) -> Result<Meaning> {
                 );
             }
         };
-        match first {
-            None => first = Some(m),
+        match self.first {
+            None => self.first = Some(m),
             Some(f) if f != m => {
                 return Err(Error::input(format!(
                     "the stream mixes {} rows with {}: one stream, one meaning",
@@ -61,8 +87,13 @@ pub fn of(table: &Table, file: &str) -> Result<Meaning> {
             }
             _ => {}
         }
+        Ok(())
     }
-    Ok(first.unwrap_or(Meaning::Tip))
+
+    /// What the rows checked so far record (tips when none says).
+    pub fn meaning(&self) -> Meaning {
+        self.first.unwrap_or(Meaning::Tip)
+    }
 }
 
 /// The meaning in words, for messages.
@@ -76,23 +107,51 @@ pub fn describe(m: &Meaning) -> String {
 /// Marks every row a tool tip: `point` = `tip` (the column added if missing) and `stylus_radius`
 /// dropped.
 pub fn mark_tip(table: &mut Table) {
-    if let Some(i) = table.schema.extra_index(STYLUS_RADIUS) {
-        table.schema.fields.retain(|f| *f != Field::Extra(i));
-        for f in &mut table.schema.fields {
-            if let Field::Extra(k) = f {
-                if *k > i {
+    let marker = TipMarker::new(&table.schema);
+    for row in &mut table.rows {
+        marker.row(row);
+    }
+    table.schema = marker.schema;
+}
+
+/// [`mark_tip`] row by row: the output's schema, and each row made to say `tip`.
+#[derive(Clone, Debug)]
+pub struct TipMarker {
+    /// The schema of the marked rows.
+    pub schema: Schema,
+    /// Index of `stylus_radius` in the input rows' extra values, removed.
+    radius: Option<usize>,
+    /// Index of `point` in the marked rows' extra values.
+    point: usize,
+}
+
+impl TipMarker {
+    /// The marker of rows of `schema`.
+    pub fn new(schema: &Schema) -> TipMarker {
+        let mut out = schema.clone();
+        let radius = out.extra_index(STYLUS_RADIUS);
+        if let Some(i) = radius {
+            out.fields.retain(|f| *f != Field::Extra(i));
+            for f in &mut out.fields {
+                if let Field::Extra(k) = f
+                    && *k > i
+                {
                     *k -= 1;
                 }
             }
+            out.extra_names.remove(i);
         }
-        table.schema.extra_names.remove(i);
-        for row in &mut table.rows {
+        let point = out.add_extra(POINT);
+        TipMarker { schema: out, radius, point }
+    }
+
+    /// Marks one row of the input schema as a tip row of [`TipMarker::schema`].
+    pub fn row(&self, row: &mut Row) {
+        if let Some(i) = self.radius {
             row.extra.remove(i);
         }
-    }
-    let p = table.add_extra_column(POINT);
-    for row in &mut table.rows {
-        row.extra[p] = TIP.to_string();
+        row.extra.resize(self.schema.extra_names.len(), String::new());
+        row.extra[self.point] = TIP.to_string();
     }
 }
 

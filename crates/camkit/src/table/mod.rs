@@ -153,6 +153,17 @@ impl Schema {
         self.fields.retain(|f| !matches!(f, Field::Known(c) if cols.contains(c)));
     }
 
+    /// Appends an unknown (filter-named) column at the end (an existing one of that name is
+    /// reused); returns its index into [`Row::extra`].
+    pub fn add_extra(&mut self, name: &str) -> usize {
+        if let Some(i) = self.extra_index(name) {
+            return i;
+        }
+        self.extra_names.push(name.to_string());
+        self.fields.push(Field::Extra(self.extra_names.len() - 1));
+        self.extra_names.len() - 1
+    }
+
     /// Index into [`Row::extra`] of the unknown column `name`.
     pub fn extra_index(&self, name: &str) -> Option<usize> {
         self.extra_names.iter().position(|n| n == name)
@@ -172,14 +183,10 @@ impl Table {
     /// Appends an unknown (filter-named) column at the end, empty in every row; returns its
     /// index into [`Row::extra`]. An existing column of that name is reused.
     pub fn add_extra_column(&mut self, name: &str) -> usize {
-        if let Some(i) = self.schema.extra_index(name) {
-            return i;
-        }
-        let i = self.schema.extra_names.len();
-        self.schema.extra_names.push(name.to_string());
-        self.schema.fields.push(Field::Extra(i));
+        let i = self.schema.add_extra(name);
+        let n = self.schema.extra_names.len();
         for row in &mut self.rows {
-            row.extra.resize(i + 1, String::new());
+            row.extra.resize(n, String::new());
         }
         i
     }
