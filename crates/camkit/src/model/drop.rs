@@ -6,13 +6,16 @@
 //! dropped onto exactly (facet, vertex and edge tests of [`super::cutter`]), pruned by a
 //! hierarchy of boxes in that frame: a box outside the cutter's shadow, or whose top less the
 //! cutter's height at the box's distance from the axis (a bound of every tip it can give) is not
-//! above the best tip so far, is skipped. Planes, spheres and cylinders across or along the axis
+//! above the best tip so far, is skipped; so is one whose slab (the plane of its triangles' mean
+//! normal through its highest corner along it) gives no tip above the best, and a triangle whose
+//! own plane does not. Each corner and edge shared by several triangles is tested in one of
+//! them, and a drop along a line starts from the tip touching the contact before. Planes, spheres and cylinders across or along the axis
 //! have closed forms. Other surfaces (cones, tori, cylinders at a slant, free-form
 //! patches) are refused by [`DropCutter::new`]: tessellate them to STL.
 
 use super::analytic::Analytic;
 use super::bvh::{Aabb, Bvh};
-use super::cutter::{Cutter, Touch};
+use super::cutter::{Cutter, Facet, Owned, Plane, Touch};
 use super::{Geometry, Model};
 use crate::geom::{P3, V3};
 use nalgebra::{Isometry3, UnitQuaternion};
@@ -54,8 +57,9 @@ impl AxisFrame {
 /// One surface in the axis frame.
 #[derive(Clone, Debug)]
 enum Part {
-    /// Triangles (corners, unit normal with n.z ≥ 0) in the hierarchy's order.
-    Mesh { tris: Vec<([P3; 3], V3)>, index: Bvh },
+    /// Triangles in the hierarchy's order with their boxes (a bound of a triangle's tips as a
+    /// node's is), and each node's slab.
+    Mesh { tris: Vec<(Facet, Aabb)>, index: Bvh, slabs: Vec<Option<Plane>> },
     /// A plane not along the axis: a point and the unit normal with n.z > 0.
     Plane { point: P3, normal: V3 },
     /// A sphere.
@@ -66,6 +70,77 @@ enum Part {
     /// A finite cylinder along the axis: its upper rim (centre and radius).
     Rim { centre: P3, radius: f64 },
 }
+
+/// The bits of a point (−0 as 0): equal points give equal drops.
+fn point_key(p: &P3) -> [u64; 3] {
+    [p.x, p.y, p.z].map(|v| (v + 0.0).to_bits())
+}
+
+/// The triangles of a mesh (corners in the axis frame, in the hierarchy's order) ready for
+/// `cutter`, with their boxes. Each shared corner and edge is tested by the first triangle
+/// holding it, which is searched whenever the feature can give the best tip (its box holds it).
+fn facets(cutter: &Cutter, tris: Vec<[P3; 3]>) -> Vec<(Facet, Aabb)> {
+    use std::collections::{HashMap, HashSet};
+    let mut corners: HashSet<[u64; 3]> = HashSet::with_capacity(tris.len());
+    // Edge (lower key first) → its first triangle, its edge number there, and whether it runs
+    // from the lower key.
+    type Key = [u64; 3];
+    let mut edges: HashMap<(Key, Key), (usize, usize, bool)> = HashMap::with_capacity(2 * tris.len());
+    let mut out: Vec<(Facet, Aabb)> = Vec::with_capacity(tris.len());
+    for (i, t) in tris.into_iter().enumerate() {
+        let n = (t[1] - t[0]).cross(&(t[2] - t[0])).normalize();
+        let keys = t.map(|p| point_key(&p));
+        let mut own = Owned { corners: 0, edges: 0, reversed: 0 };
+        for k in 0..3 {
+            if corners.insert(keys[k]) {
+                own.corners |= 1 << k;
+            }
+            let (a, b) = (keys[k], keys[(k + 1) % 3]);
+            let up = a <= b;
+            let key = if up { (a, b) } else { (b, a) };
+            match edges.get(&key) {
+                None => {
+                    edges.insert(key, (i, k, up));
+                    own.edges |= 1 << k;
+                }
+                Some(&(first, j, way)) if way != up => {
+                    out[first].0.own.reversed |= 1 << j;
+                }
+                Some(_) => {}
+            }
+        }
+        out.push((Facet::new(cutter, t, if n.z < 0.0 { -n } else { n }, own), Aabb::of(&t)));
+    }
+    out
+}
+
+/// Each node's slab: the plane of the mean normal of its triangles (taken if n.z ≥ 0.1) through
+/// its corner highest along that normal. Everything under the node lies below that plane, so the
+/// drop onto the plane bounds its tips; on a smooth mesh the plane hugs the node's triangles far
+/// more closely than its box's top does on a slope.
+fn slabs(cutter: &Cutter, tris: &[(Facet, Aabb)], index: &Bvh) -> Vec<Option<Plane>> {
+    index
+        .spans()
+        .into_iter()
+        .map(|span| {
+            let tris = &tris[span];
+            // Area-weighted: each triangle's normal (n.z ≥ 0) times its doubled area.
+            let sum =
+                tris.iter().fold(V3::zeros(), |s, (f, _)| s + f.n * (f.t[1] - f.t[0]).cross(&(f.t[2] - f.t[0])).norm());
+            let n = sum.try_normalize(1e-300)?;
+            if n.z < 0.1 {
+                return None;
+            }
+            let top =
+                tris.iter().flat_map(|(f, _)| f.t).max_by(|a, b| n.dot(&a.coords).total_cmp(&n.dot(&b.coords)))?;
+            Some(Plane::new(cutter, top, n))
+        })
+        .collect()
+}
+
+/// What a bound by a plane is raised by for rounding (mm): the plane's drop and the features'
+/// tips round differently, by far less than this for models within a few metres.
+pub const PLANE_MARGIN: f64 = 1e-9;
 
 /// A surface the drop-cutter does not handle, and why.
 #[derive(Clone, Debug, PartialEq)]
@@ -114,18 +189,12 @@ impl DropCutter {
             let refuse = |what: &str| Unsupported { surface: i, what: what.to_string() };
             let part = match &s.geometry {
                 Geometry::Mesh(m) => {
-                    let tris: Vec<([P3; 3], V3)> = m
-                        .corners()
-                        .map(|t| {
-                            let t = t.map(|p| pt(&p));
-                            let n = (t[1] - t[0]).cross(&(t[2] - t[0])).normalize();
-                            (t, if n.z < 0.0 { -n } else { n })
-                        })
-                        .collect();
-                    let boxes: Vec<Aabb> = tris.iter().map(|(t, _)| Aabb::of(t)).collect();
+                    let tris: Vec<[P3; 3]> = m.corners().map(|t| t.map(|p| pt(&p))).collect();
+                    let boxes: Vec<Aabb> = tris.iter().map(|t| Aabb::of(t)).collect();
                     let index = Bvh::build(&boxes);
-                    let tris = index.order.iter().map(|&k| tris[k as usize]).collect();
-                    Part::Mesh { tris, index }
+                    let tris = facets(&cutter, index.order.iter().map(|&k| tris[k as usize]).collect());
+                    let slabs = slabs(&cutter, &tris, &index);
+                    Part::Mesh { tris, index, slabs }
                 }
                 Geometry::Analytic(Analytic::Plane { point, normal }) => {
                     let n = vec(normal);
@@ -182,8 +251,21 @@ impl DropCutter {
     /// The drop at (u, v) of the axis frame: the highest tip touching the model, or `None` where
     /// nothing of the model is under the cutter.
     pub fn drop(&self, u: f64, v: f64) -> Option<Drop> {
+        self.drop_near(u, v, None)
+    }
+
+    /// [`DropCutter::drop`] given a point `near` of the model (model frame; the contact of the
+    /// drop before, along a line): the tip touching it is a lower bound of the drop, so the search
+    /// prunes with it from the start (taken [`PLANE_MARGIN`] lower, so the best is never pruned
+    /// for rounding). The result is the drop's whatever the point.
+    pub fn drop_near(&self, u: f64, v: f64, near: Option<P3>) -> Option<Drop> {
         let q = [u, v];
         let big_r = self.cutter.radius();
+        let start = near.map_or(f64::NEG_INFINITY, |p| {
+            let p = self.frame.to_frame(&p);
+            let rho = (p.x - u).hypot(p.y - v);
+            if rho <= big_r { p.z - self.cutter.height(rho) - PLANE_MARGIN } else { f64::NEG_INFINITY }
+        });
         let shadow = |b: &Aabb| {
             let dx = (b.min.x - u).max(u - b.max.x).max(0.0);
             let dy = (b.min.y - v).max(v - b.max.y).max(0.0);
@@ -191,10 +273,10 @@ impl DropCutter {
         };
         let mut best: Option<(Touch, V3, usize)> = None;
         for (i, (part, bounds)) in self.parts.iter().enumerate() {
-            if !shadow(bounds) || best.is_some_and(|(t, _, _)| bounds.max.z <= t.tip) {
+            let floor = best.map_or(start, |(t, _, _)| t.tip.max(start));
+            if !shadow(bounds) || bounds.max.z <= floor {
                 continue;
             }
-            let floor = best.map_or(f64::NEG_INFINITY, |(t, _, _)| t.tip);
             let found = self.drop_part(q, part, floor);
             if let Some((t, n)) = found {
                 if best.is_none_or(|(b, _, _)| t.tip > b.tip) {
@@ -216,27 +298,38 @@ impl DropCutter {
     fn drop_part(&self, q: [f64; 2], part: &Part, floor: f64) -> Option<(Touch, V3)> {
         let c = &self.cutter;
         match part {
-            Part::Mesh { tris, index } => {
+            Part::Mesh { tris, index, slabs } => {
                 // No point of a box is nearer the axis than the box itself, and f grows with ρ:
                 // its top less f at that distance bounds every tip it can give.
                 let bound = |b: &Aabb| {
                     let dx = (b.min.x - q[0]).max(q[0] - b.max.x).max(0.0);
                     let dy = (b.min.y - q[1]).max(q[1] - b.max.y).max(0.0);
-                    let rho = dx.hypot(dy);
+                    let rho = (dx * dx + dy * dy).sqrt();
                     // Taken 1e-9 nearer: rounding of ρ must not lower the bound where f is steep
                     // (at the rim of a ball or bull-nose f′ is infinite).
                     let top =
                         if rho <= c.radius() { b.max.z - c.height((rho - 1e-9).max(0.0)) } else { f64::NEG_INFINITY };
                     if top > floor { top } else { f64::NEG_INFINITY }
                 };
+                let node_bound = |n: usize, b: &Aabb| {
+                    let top = bound(b);
+                    match &slabs[n] {
+                        Some(p) if top > f64::NEG_INFINITY => {
+                            let top = top.min(c.drop_on(q, p).tip + PLANE_MARGIN);
+                            if top > floor { top } else { f64::NEG_INFINITY }
+                        }
+                        _ => top,
+                    }
+                };
                 index
-                    .maximise(bound, |k, best| {
-                        let (t, n) = &tris[k];
+                    .maximise(node_bound, |k, best| {
+                        let (f, b) = &tris[k];
                         // The triangle's own box bounds its tips as a node's does.
-                        if bound(&Aabb::of(t)) <= best.max(floor) {
+                        let floor = best.max(floor);
+                        if bound(b) <= floor {
                             return None;
                         }
-                        c.drop_triangle(q, t, n, best.max(floor)).map(|touch| (touch.tip, (touch, *n)))
+                        c.drop_facet(q, f, floor).map(|touch| (touch.tip, (touch, f.n)))
                     })
                     .map(|(_, found)| found)
             }
@@ -321,6 +414,7 @@ mod tests {
             ],
             axis in prop::array::uniform3(-0.4..0.4f64),
             q in prop::array::uniform2(-2.0..8.0f64),
+            near in (0..1000usize, 0..1000usize),
         ) {
             let p = |i: usize, j: usize| P3::new(i as f64, j as f64 + 0.3 * i as f64, heights[7 * i + j]);
             let mut tris = Vec::new();
@@ -353,6 +447,15 @@ mod tests {
             }
             let got = dc.drop(q[0], q[1]);
             prop_assert_eq!(got.is_some(), brute.is_some());
+            // Started from any point of the mesh (a corner, or a point inside a triangle), the
+            // search finds the same drop.
+            for near in [p(near.0 % 7, near.1 % 7), nalgebra::center(&tris[near.0 % 72][0], &tris[near.0 % 72][2])] {
+                let again = dc.drop_near(q[0], q[1], Some(near));
+                prop_assert_eq!(again.is_some(), got.is_some());
+                if let (Some(a), Some(g)) = (again, got) {
+                    prop_assert!((a.tip - g.tip).norm() <= 1e-12 * (1.0 + g.tip.z.abs()), "{:?} vs {:?}", a.tip, g.tip);
+                }
+            }
             if let (Some(g), Some(b)) = (got, brute) {
                 let tip = frame.to_frame(&g.tip);
                 prop_assert!((tip.z - b.tip).abs() <= 1e-12 * (1.0 + b.tip.abs()), "{} vs {}", tip.z, b.tip);
