@@ -1076,7 +1076,8 @@ fn fixed_axis_cutters_agree_with_opencamlib() {
 }
 
 /// Closed forms on analytic models: flat on a sphere, bull on a tilted plane and on a cylinder
-/// across the axis; a ball on a sphere along a slanted axis; the same table for 1 and 2 threads.
+/// across the axis; a ball on a sphere along a slanted axis and on a slanted cylinder; the same
+/// table for 1 and 2 threads.
 #[test]
 fn fixed_axis_cutters_on_analytic_models() {
     let w = Work::new();
@@ -1129,6 +1130,31 @@ fn fixed_axis_cutters_on_analytic_models() {
         assert!((a - axis).norm() < 1e-12);
         assert!(((tip + axis * 2.0).coords.norm() - 12.0).abs() < 1e-9, "{tip}");
     }
+    // Ball R2 on an endless cylinder R3 through the origin along (sin 50°, 0, cos 50°): the
+    // centre (x, y, tip + 2) is 5 from the axis, the higher root; a flat is refused there.
+    let th = 50f64.to_radians();
+    let axis = V3::new(th.sin(), 0.0, th.cos());
+    w.write(
+        "slant.json",
+        format!(
+            r#"{{"surfaces": [{{"type": "cylinder", "point": [0, 0, 0], "axis": [{}, 0, {}], "radius": 3}}]}}"#,
+            th.sin(),
+            th.cos()
+        ),
+    );
+    let rows = run("slant.json", "ball.json", &["--region=-4,4,-4.75,4.75"]);
+    assert!(rows.len() > 300);
+    for (tip, _, contact, n, _) in &rows {
+        // x sin + z cos = t along the axis: |c − t·axis|² = 25 is a quadratic in z.
+        let (x, y) = (tip.x, tip.y);
+        let (a2, b1, c0) = (th.sin().powi(2), -2.0 * x * th.sin() * th.cos(), x * x * th.cos().powi(2) + y * y - 25.0);
+        let want = (-b1 + (b1 * b1 - 4.0 * a2 * c0).sqrt()) / (2.0 * a2) - 2.0;
+        assert!((tip.z - want).abs() < 1e-9, "{tip}: {want}");
+        let radial = |p: &P3| p.coords - axis * p.coords.dot(&axis);
+        assert!((radial(contact).norm() - 3.0).abs() < 1e-9 && (n - radial(contact) / 3.0).norm() < 1e-9);
+    }
+    w.run(BIN, &["slant.json", "--tool", "flat.json", "--region=-4,4,-6,6", "-o", "f.csv"], b"")
+        .fails(2, "a cylinder at a slant to the tool axis (handled for a ball cutter on an endless one)");
     let threads = |n: &str| {
         let args = ["--tool", "ball.json", "--pick", "0.5", "--max-step", "0.5", "--axis", "1,-1,2", "--threads", n];
         w.run(BIN, &[&["sphere.json"][..], &args].concat(), b"")

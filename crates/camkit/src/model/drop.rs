@@ -10,8 +10,9 @@
 //! normal through its highest corner along it) gives no tip above the best, and a triangle whose
 //! own plane does not. Each corner and edge shared by several triangles is tested in one of
 //! them, and a drop along a line starts from the tip touching the contact before. Planes, spheres and cylinders across or along the axis
-//! have closed forms. Other surfaces (cones, tori, cylinders at a slant, free-form
-//! patches) are refused by [`DropCutter::new`]: tessellate them to STL.
+//! have closed forms, and so has a ball on an endless cylinder at a slant. Other surfaces (cones,
+//! tori, other cylinders at a slant, free-form patches) are refused by [`DropCutter::new`]:
+//! tessellate them to STL.
 
 use super::analytic::Analytic;
 use super::bvh::{Aabb, Bvh};
@@ -69,6 +70,8 @@ enum Part {
     Across { point: P3, axis: V3, radius: f64, from: f64, to: f64 },
     /// A finite cylinder along the axis: its upper rim (centre and radius).
     Rim { centre: P3, radius: f64 },
+    /// An endless cylinder at a slant, for a ball: a point of its axis, the unit axis, the radius.
+    Slant { point: P3, axis: V3, radius: f64 },
 }
 
 /// The bits of a point (−0 as 0): equal points give equal drops.
@@ -223,8 +226,12 @@ impl DropCutter {
                         let top = if a.z > 0.0 { *to } else { *from };
                         let centre = p + a * top;
                         Part::Rim { centre, radius: *radius }
+                    } else if matches!(cutter, Cutter::Ball { .. }) && !from.is_finite() && !to.is_finite() {
+                        Part::Slant { point: p, axis: a, radius: *radius }
                     } else {
-                        return Err(refuse("a cylinder at a slant to the tool axis: tessellate it to STL"));
+                        return Err(refuse(
+                            "a cylinder at a slant to the tool axis (handled for a ball cutter on an endless one): tessellate it to STL",
+                        ));
                     }
                 }
                 Geometry::Analytic(Analytic::Cone { .. }) => {
@@ -355,6 +362,23 @@ impl DropCutter {
                 let contact = P3::new(q[0] + ux * along, q[1] + uy * along, z);
                 Some((Touch { tip, contact }, (contact - foot) / *radius))
             }
+            Part::Slant { point, axis, radius } => {
+                // The ball's centre (q, z) is R + r from the axis where it touches: |A + zB|² =
+                // (R + r)² with A = (q − point) × axis, B = z × axis; the higher root.
+                let big_r = c.radius();
+                let a = V3::new(q[0] - point.x, q[1] - point.y, -point.z).cross(axis);
+                let b = V3::z().cross(axis);
+                let (bb, ab) = (b.norm_squared(), a.dot(&b));
+                let disc = ab * ab - bb * (a.norm_squared() - (radius + big_r).powi(2));
+                if disc < 0.0 {
+                    return None;
+                }
+                let z = (disc.sqrt() - ab) / bb;
+                let centre = P3::new(q[0], q[1], z);
+                let foot = point + axis * (centre - point).dot(axis);
+                let n = (centre - foot).normalize();
+                Some((Touch { tip: z - big_r, contact: centre - n * big_r }, n))
+            }
             Part::Rim { centre, radius } => {
                 let (dx, dy) = (q[0] - centre.x, q[1] - centre.y);
                 let d = dx.hypot(dy);
@@ -383,7 +407,7 @@ fn frame_of(frame: &AxisFrame, placement: Option<&Isometry3<f64>>) -> Isometry3<
 fn part_bounds(part: &Part) -> Aabb {
     match part {
         Part::Mesh { index, .. } => index.bounds(),
-        Part::Plane { .. } | Part::Across { .. } => Aabb::everything(),
+        Part::Plane { .. } | Part::Across { .. } | Part::Slant { .. } => Aabb::everything(),
         Part::Sphere { centre, radius } => {
             Aabb { min: centre - V3::repeat(*radius), max: centre + V3::repeat(*radius) }
         }
@@ -617,6 +641,80 @@ mod tests {
         assert!((dc.frame.to_frame(&d.tip) - P3::new(4.5, 4.5, 0.0)).norm() < 1e-12);
     }
 
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(48))]
+        /// A ball on an endless cylinder at a slant: the closed form is exact, so it is at least
+        /// the drop onto the cylinder tessellated finely (corners on it: the mesh lies inside)
+        /// and above it by no more than the tessellation's sagitta s seen along the contact's
+        /// normal (s / n·z); the contact is on the cylinder, R from the ball's centre.
+        #[test]
+        fn ball_on_a_slanted_cylinder_is_above_its_tessellation_by_at_most_the_sagitta(
+            tilt in 0.35..1.45f64,
+            turn in 0.0..std::f64::consts::TAU,
+            radius in 0.5..5.0f64,
+            big_r in 0.3..4.0f64,
+            q in prop::array::uniform2(-4.0..4.0f64),
+        ) {
+            let axis = V3::new(tilt.sin() * turn.cos(), tilt.sin() * turn.sin(), tilt.cos());
+            let point = P3::new(0.3, -0.2, 1.0);
+            let surface = Geometry::Analytic(Analytic::Cylinder { point, axis, radius, from: f64::NEG_INFINITY, to: f64::INFINITY });
+            let m = Model { surfaces: vec![super::super::Surface::new("c".into(), surface, None, false)] };
+            let ball = Cutter::Ball { radius: big_r };
+            let got = DropCutter::new(&m, ball, V3::z()).unwrap().drop(q[0], q[1]);
+            // The tessellation: 720 strips along the axis, ±60 around the point nearest q's
+            // vertical line (the shadow reaches at most (R + r) / sin(tilt) < 30 along it).
+            let n = 720;
+            let (e1, e2) = (super::super::analytic::any_perpendicular(&axis), axis.cross(&super::super::analytic::any_perpendicular(&axis)));
+            let mid = (P3::new(q[0], q[1], 0.0) - point).dot(&axis);
+            let at = |k: usize, t: f64| {
+                let th = std::f64::consts::TAU * k as f64 / n as f64;
+                point + axis * (mid + t) + (e1 * th.cos() + e2 * th.sin()) * radius
+            };
+            let mut tris = Vec::new();
+            for k in 0..n {
+                tris.push([at(k, -60.0), at(k + 1, -60.0), at(k + 1, 60.0)]);
+                tris.push([at(k, -60.0), at(k + 1, 60.0), at(k, 60.0)]);
+            }
+            let mesh = super::super::mesh::Mesh::new(&tris).unwrap();
+            let mm = Model { surfaces: vec![super::super::Surface::new("t".into(), Geometry::Mesh(mesh), None, false)] };
+            let want = DropCutter::new(&mm, ball, V3::z()).unwrap().drop(q[0], q[1]);
+            let sagitta = radius * (1.0 - (std::f64::consts::PI / n as f64).cos());
+            match (got, want) {
+                (None, None) => {}
+                (Some(g), Some(w)) => {
+                    prop_assert!(g.tip.z >= w.tip.z - 1e-9, "exact {} below the mesh's {}", g.tip.z, w.tip.z);
+                    if g.normal.z > 0.05 {
+                        prop_assert!(g.tip.z - w.tip.z <= sagitta / g.normal.z + 1e-9, "exact {} mesh {}", g.tip.z, w.tip.z);
+                    }
+                    let c = g.contact - point;
+                    prop_assert!(((c - axis * c.dot(&axis)).norm() - radius).abs() < 1e-9);
+                    prop_assert!(((g.tip + V3::z() * big_r - g.contact).norm() - big_r).abs() < 1e-9);
+                }
+                // The mesh inside the cylinder may be out of reach only where the ball touches it
+                // within s of its rim: ρ ≥ R − s, n·z = √(1 − (ρ/R)²) ≤ √(2s/R).
+                (Some(g), None) => prop_assert!(g.normal.z <= 2.0 * (2.0 * sagitta / big_r).sqrt(), "{g:?}"),
+                (None, Some(w)) => prop_assert!(false, "the mesh is under the ball: {w:?}"),
+            }
+        }
+    }
+
+    #[test]
+    fn ball_on_a_slanted_cylinder_is_the_closed_form() {
+        // Cylinder r = 2 through the origin along (sin θ, 0, cos θ), ball R = 1 at (0, 0): the
+        // centre is 3 from the axis straight above it, at height 3 / sin θ; the tip is R lower.
+        for theta in [0.4f64, 0.9, 1.3] {
+            let m = model(&format!(
+                r#"{{"surfaces": [{{"type": "cylinder", "point": [0,0,0], "axis": [{}, 0, {}], "radius": 2}}]}}"#,
+                theta.sin(),
+                theta.cos()
+            ));
+            let d = DropCutter::new(&m, Cutter::Ball { radius: 1.0 }, V3::z()).unwrap().drop(0.0, 0.0).unwrap();
+            assert!((d.tip.z - (3.0 / theta.sin() - 1.0)).abs() < 1e-12, "{theta}: {}", d.tip.z);
+            // The normal is the radial direction, across the axis in the x-z plane.
+            assert!((d.normal - V3::new(-theta.cos(), 0.0, theta.sin())).norm() < 1e-12, "{:?}", d.normal);
+        }
+    }
+
     #[test]
     fn refuses_what_it_cannot_drop_onto() {
         let m = model(
@@ -627,5 +725,14 @@ mod tests {
         let m = model(r#"{"surfaces": [{"type": "plane", "point": [0,0,0], "normal": [1,0,0]}]}"#);
         assert!(DropCutter::new(&m, Cutter::Ball { radius: 1.0 }, V3::z()).is_err());
         assert!(DropCutter::new(&m, Cutter::Ball { radius: 1.0 }, V3::x()).is_ok());
+        // A slanted cylinder: a ball on an endless one only.
+        let m = model(r#"{"surfaces": [{"type": "cylinder", "point": [0,0,0], "axis": [1,0,1], "radius": 1}]}"#);
+        assert!(DropCutter::new(&m, Cutter::Ball { radius: 1.0 }, V3::z()).is_ok());
+        let e = DropCutter::new(&m, Cutter::Flat { radius: 1.0 }, V3::z()).unwrap_err();
+        assert!(e.what.contains("slant"), "{e:?}");
+        let m = model(
+            r#"{"surfaces": [{"type": "cylinder", "point": [0,0,0], "axis": [1,0,1], "radius": 1, "length": [0, 5]}]}"#,
+        );
+        assert!(DropCutter::new(&m, Cutter::Ball { radius: 1.0 }, V3::z()).is_err());
     }
 }
