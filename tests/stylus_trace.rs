@@ -1076,8 +1076,8 @@ fn fixed_axis_cutters_agree_with_opencamlib() {
 }
 
 /// Closed forms on analytic models: flat on a sphere, bull on a tilted plane and on a cylinder
-/// across the axis; a ball on a sphere along a slanted axis and on a slanted cylinder; the same
-/// table for 1 and 2 threads.
+/// across the axis; a ball on a sphere along a slanted axis, on a slanted cylinder and on a torus;
+/// the same table for 1 and 2 threads.
 #[test]
 fn fixed_axis_cutters_on_analytic_models() {
     let w = Work::new();
@@ -1153,6 +1153,16 @@ fn fixed_axis_cutters_on_analytic_models() {
         let radial = |p: &P3| p.coords - axis * p.coords.dot(&axis);
         assert!((radial(contact).norm() - 3.0).abs() < 1e-9 && (n - radial(contact) / 3.0).norm() < 1e-9);
     }
+    // Ball R2 on a torus R 8, r 1 about z: the centre is 3 from the tube's centre circle, so
+    // tip = √(9 − (d − 8)²) − 2 at distance d from the torus's axis.
+    w.write("torus.json", r#"{"surfaces": [{"type": "torus", "centre": [0, 0, 0], "axis": [0, 0, 1], "major_radius": 8, "minor_radius": 1}]}"#);
+    let rows = run("torus.json", "ball.json", &["--region=5.5,10.5,-1,1"]);
+    assert!(rows.len() > 40);
+    for (tip, ..) in &rows {
+        let d = tip.x.hypot(tip.y);
+        let want = (9.0 - (d - 8.0f64).powi(2)).sqrt() - 2.0;
+        assert!((tip.z - want).abs() < 1e-9, "{tip}: {want}");
+    }
     w.run(BIN, &["slant.json", "--tool", "flat.json", "--region=-4,4,-6,6", "-o", "f.csv"], b"")
         .fails(2, "a cylinder at a slant to the tool axis (handled for a ball cutter on an endless one)");
     let threads = |n: &str| {
@@ -1178,7 +1188,8 @@ fn fixed_axis_bad_input() {
         .fails(2, "bull.json:1:48 (corner_radius): corner_radius 4 exceeds the radius 3");
     go(&["sphere.json", "--tool", "cone.json"]).fails(2, "cone.json:1:1 (half_angle): a cone cutter needs half_angle");
     go(&["sphere.json", "--tool", "cyl.json"]).fails(2, "does not rotate");
-    go(&["torus.json", "--tool", "ball.json"]).fails(2, "torus.json: surface torus#0: torus surfaces are not handled");
+    go(&["torus.json", "--tool", "ball.json", "--axis", "1,0,1"])
+        .fails(2, "torus.json: surface torus#0: a torus is handled by the drop-cutter only along the tool axis");
     go(&["sphere.json", "--tool", "ball.json", "--mode", "contour"]).fails(2, "--mode scan only");
     go(&["sphere.json", "--tool", "ball.json", "--axis", "0,0,0"]).fails(2, "--axis must be a nonzero direction");
     go(&["sphere.json", "--tool", "ball.json", "--region=20,30,20,30"]).fails(2, "misses the model");

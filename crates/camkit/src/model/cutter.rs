@@ -441,6 +441,27 @@ impl Cutter {
         }
     }
 
+    /// The drop onto a torus whose axis is the tool axis's direction, its centre at distance
+    /// `d` ≥ 0 from the tool axis and height `cz`: the tip and the contact as (distance from the
+    /// torus's axis towards the tool axis, height); `None` for a cone (not handled) or where the
+    /// torus is not under the cutter. Exact: a flat, ball or bull-nose is a disc of radius c grown
+    /// by r, so it touches the torus where the disc touches the torus grown by r (its tube
+    /// `minor` + r), whose height at distance ρ from its axis depends on ρ alone and is highest
+    /// at ρ = `major`; the disc spans ρ over [d − c, d + c] (from 0 if it holds the axis).
+    pub fn drop_torus(&self, d: f64, cz: f64, major: f64, minor: f64) -> Option<(f64, f64, f64)> {
+        let (c, r) = self.torus()?;
+        let tube = minor + r;
+        let rho = major.clamp((d - c).max(0.0), d + c);
+        let off = rho - major;
+        if off.abs() > tube {
+            return None;
+        }
+        let up = (tube * tube - off * off).sqrt();
+        // The contact: from the tube's centre circle towards the grown torus's point, minor away.
+        let s = minor / tube;
+        Some((cz + up - r, major + off * s, cz + up * s))
+    }
+
     /// The model's unit normal at a contact (pointing out of the model, into the cutter) where
     /// the cutter's surface is smooth; `fallback` (the model's own normal) where the contact is
     /// on a corner of the cutter (a flat's or cone's rim, a cone's tip).

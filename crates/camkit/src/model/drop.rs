@@ -10,9 +10,9 @@
 //! normal through its highest corner along it) gives no tip above the best, and a triangle whose
 //! own plane does not. Each corner and edge shared by several triangles is tested in one of
 //! them, and a drop along a line starts from the tip touching the contact before. Planes, spheres and cylinders across or along the axis
-//! have closed forms, and so has a ball on an endless cylinder at a slant. Other surfaces (cones,
-//! tori, other cylinders at a slant, free-form patches) are refused by [`DropCutter::new`]:
-//! tessellate them to STL.
+//! have closed forms, and so have a ball on an endless cylinder at a slant and a flat, ball or
+//! bull-nose on a torus along the axis. Other surfaces (cones, other tori and cylinders at a
+//! slant, free-form patches) are refused by [`DropCutter::new`]: tessellate them to STL.
 
 use super::analytic::Analytic;
 use super::bvh::{Aabb, Bvh};
@@ -72,6 +72,8 @@ enum Part {
     Rim { centre: P3, radius: f64 },
     /// An endless cylinder at a slant, for a ball: a point of its axis, the unit axis, the radius.
     Slant { point: P3, axis: V3, radius: f64 },
+    /// A torus whose axis is along the tool axis, for a flat, ball or bull-nose: centre, radii.
+    Torus { centre: P3, major: f64, minor: f64 },
 }
 
 /// The bits of a point (−0 as 0): equal points give equal drops.
@@ -237,8 +239,13 @@ impl DropCutter {
                 Geometry::Analytic(Analytic::Cone { .. }) => {
                     return Err(refuse("cone surfaces are not handled by the drop-cutter: tessellate them to STL"));
                 }
-                Geometry::Analytic(Analytic::Torus { .. }) => {
-                    return Err(refuse("torus surfaces are not handled by the drop-cutter: tessellate them to STL"));
+                Geometry::Analytic(Analytic::Torus { centre, axis, major, minor }) => {
+                    if vec(axis).z.abs() < 1.0 - ACROSS || matches!(cutter, Cutter::Cone { .. }) {
+                        return Err(refuse(
+                            "a torus is handled by the drop-cutter only along the tool axis and for a flat, ball or bull-nose cutter: tessellate it to STL",
+                        ));
+                    }
+                    Part::Torus { centre: pt(centre), major: *major, minor: *minor }
                 }
                 Geometry::Patch(_) => {
                     return Err(refuse("free-form patches are not handled by the drop-cutter: tessellate them to STL"));
@@ -379,6 +386,15 @@ impl DropCutter {
                 let n = (centre - foot).normalize();
                 Some((Touch { tip: z - big_r, contact: centre - n * big_r }, n))
             }
+            Part::Torus { centre, major, minor } => {
+                let (dx, dy) = (q[0] - centre.x, q[1] - centre.y);
+                let d = dx.hypot(dy);
+                let (ux, uy) = if d > 0.0 { (dx / d, dy / d) } else { (1.0, 0.0) };
+                let (tip, along, z) = c.drop_torus(d, centre.z, *major, *minor)?;
+                let contact = P3::new(centre.x + ux * along, centre.y + uy * along, z);
+                let core = P3::new(centre.x + ux * major, centre.y + uy * major, centre.z);
+                Some((Touch { tip, contact }, (contact - core) / *minor))
+            }
             Part::Rim { centre, radius } => {
                 let (dx, dy) = (q[0] - centre.x, q[1] - centre.y);
                 let d = dx.hypot(dy);
@@ -410,6 +426,10 @@ fn part_bounds(part: &Part) -> Aabb {
         Part::Plane { .. } | Part::Across { .. } | Part::Slant { .. } => Aabb::everything(),
         Part::Sphere { centre, radius } => {
             Aabb { min: centre - V3::repeat(*radius), max: centre + V3::repeat(*radius) }
+        }
+        Part::Torus { centre, major, minor } => {
+            let e = V3::new(major + minor, major + minor, *minor);
+            Aabb { min: centre - e, max: centre + e }
         }
         Part::Rim { centre, radius } => {
             Aabb { min: centre - V3::new(*radius, *radius, 0.0), max: centre + V3::new(*radius, *radius, 0.0) }
@@ -699,6 +719,87 @@ mod tests {
     }
 
     #[test]
+    fn flat_on_a_torus_along_its_axis_is_the_closed_form() {
+        // Torus R 5, r 1 at (1, 2, 3) about z (given upside down), flat R 2 at distance d from
+        // its axis: the disc spans ρ over [d − 2, d + 2]; on the top (tip 4) while that holds 5,
+        // else at the nearer end ρ*: tip 3 + √(1 − (ρ* − 5)²).
+        let m = model(
+            r#"{"surfaces": [{"type": "torus", "centre": [1,2,3], "axis": [0,0,-1], "major_radius": 5, "minor_radius": 1}]}"#,
+        );
+        let dc = DropCutter::new(&m, Cutter::Flat { radius: 2.0 }, V3::z()).unwrap();
+        for d in [2.5, 3.0, 5.0, 7.0, 7.5, 7.9] {
+            let near = 5.0f64.clamp(d - 2.0, d + 2.0);
+            let want = 3.0 + (1.0 - (near - 5.0f64).powi(2)).sqrt();
+            let got = dc.drop(1.0, 2.0 + d).unwrap();
+            assert!((got.tip.z - want).abs() < 1e-12, "d {d}: {} vs {want}", got.tip.z);
+            // The contact is on the tube, the normal from the tube's centre circle through it.
+            let c = got.contact - P3::new(1.0, 2.0, 3.0);
+            let core = V3::new(c.x, c.y, 0.0).normalize() * 5.0;
+            assert!(((c - core).norm() - 1.0).abs() < 1e-12 && (got.normal - (c - core)).norm() < 1e-12);
+        }
+        // Over the hole (ρ within [0, 2], the tube from 4) and beyond the rim nothing is under it.
+        assert!(dc.drop(1.0, 2.0).is_none() && dc.drop(1.0, 2.0 + 8.1).is_none());
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(32))]
+        /// Flat, ball and bull-nose on a torus along the tool axis against the torus tessellated
+        /// (corners on it, 360 × 90 cells): the two drops differ by at most the tessellation's
+        /// sagitta seen along the contact's normal, and the contact is on the torus.
+        #[test]
+        fn torus_drop_is_within_the_sagitta_of_its_tessellation(
+            c in prop_oneof![
+                (0.3..3.0f64).prop_map(|radius| Cutter::Flat { radius }),
+                (0.3..3.0f64).prop_map(|radius| Cutter::Ball { radius }),
+                (0.3..3.0f64, 0.1..1.0f64).prop_map(|(radius, k)| Cutter::Bull { radius, corner: radius * k }),
+            ],
+            major in 2.0..6.0f64,
+            minor in 0.3..1.5f64,
+            q in prop::array::uniform2(-8.0..8.0f64),
+        ) {
+            let torus = Geometry::Analytic(Analytic::Torus { centre: P3::new(0.5, -0.5, 1.0), axis: V3::z(), major, minor });
+            let m = Model { surfaces: vec![super::super::Surface::new("t".into(), torus, None, false)] };
+            let got = DropCutter::new(&m, c, V3::z()).unwrap().drop(q[0], q[1]);
+            let (nu, nv) = (360, 90);
+            let at = |i: usize, j: usize| {
+                let (u, v) = (std::f64::consts::TAU * i as f64 / nu as f64, std::f64::consts::TAU * j as f64 / nv as f64);
+                P3::new(0.5 + (major + minor * v.cos()) * u.cos(), -0.5 + (major + minor * v.cos()) * u.sin(), 1.0 + minor * v.sin())
+            };
+            let mut tris = Vec::new();
+            for i in 0..nu {
+                for j in 0..nv {
+                    tris.push([at(i, j), at(i + 1, j), at(i + 1, j + 1)]);
+                    tris.push([at(i, j), at(i + 1, j + 1), at(i, j + 1)]);
+                }
+            }
+            let mesh = super::super::mesh::Mesh::new(&tris).unwrap();
+            let mm = Model { surfaces: vec![super::super::Surface::new("m".into(), Geometry::Mesh(mesh), None, false)] };
+            let want = DropCutter::new(&mm, c, V3::z()).unwrap().drop(q[0], q[1]);
+            let sagitta = (major + minor) * (1.0 - (std::f64::consts::PI / nu as f64).cos())
+                + minor * (1.0 - (std::f64::consts::PI / nv as f64).cos());
+            match (got, want) {
+                (None, None) => {}
+                (Some(g), Some(w)) => {
+                    if g.normal.z > 0.05 {
+                        prop_assert!((g.tip.z - w.tip.z).abs() <= sagitta / g.normal.z + 1e-9, "exact {} mesh {}", g.tip.z, w.tip.z);
+                    }
+                    prop_assert!(g.tip.z >= w.tip.z - sagitta / 0.05 - 1e-9);
+                    let p = g.contact - P3::new(0.5, -0.5, 1.0);
+                    let core = V3::new(p.x, p.y, 0.0).normalize() * major;
+                    prop_assert!(((p - core).norm() - minor).abs() < 1e-9);
+                }
+                // Only where the cutter's rim just reaches the tube (from outside or over the
+                // hole) may one of them miss.
+                (g, w) => {
+                    let d = (q[0] - 0.5).hypot(q[1] + 0.5);
+                    let rim = (d - c.radius() - major - minor).abs().min((d + c.radius() - major + minor).abs());
+                    prop_assert!(rim < 10.0 * sagitta, "{g:?} {w:?}");
+                }
+            }
+        }
+    }
+
+    #[test]
     fn ball_on_a_slanted_cylinder_is_the_closed_form() {
         // Cylinder r = 2 through the origin along (sin θ, 0, cos θ), ball R = 1 at (0, 0): the
         // centre is 3 from the axis straight above it, at height 3 / sin θ; the tip is R lower.
@@ -720,7 +821,10 @@ mod tests {
         let m = model(
             r#"{"surfaces": [{"type": "torus", "centre": [0,0,0], "axis": [0,0,1], "major_radius": 5, "minor_radius": 1}]}"#,
         );
-        let e = DropCutter::new(&m, Cutter::Ball { radius: 1.0 }, V3::z()).unwrap_err();
+        assert!(DropCutter::new(&m, Cutter::Ball { radius: 1.0 }, V3::z()).is_ok());
+        let e = DropCutter::new(&m, Cutter::Cone { radius: 1.0, half_angle: 0.5 }, V3::z()).unwrap_err();
+        assert!(e.what.contains("torus"), "{e:?}");
+        let e = DropCutter::new(&m, Cutter::Ball { radius: 1.0 }, V3::x()).unwrap_err();
         assert!(e.what.contains("torus"), "{e:?}");
         let m = model(r#"{"surfaces": [{"type": "plane", "point": [0,0,0], "normal": [1,0,0]}]}"#);
         assert!(DropCutter::new(&m, Cutter::Ball { radius: 1.0 }, V3::z()).is_err());
