@@ -1076,8 +1076,8 @@ fn fixed_axis_cutters_agree_with_opencamlib() {
 }
 
 /// Closed forms on analytic models: flat on a sphere, bull on a tilted plane and on a cylinder
-/// across the axis; a ball on a sphere along a slanted axis, on a slanted cylinder and on a torus;
-/// the same table for 1 and 2 threads.
+/// across the axis and in a funnel (a cone); a ball on a sphere along a slanted axis, on a slanted
+/// cylinder and on a torus; the same table for 1 and 2 threads.
 #[test]
 fn fixed_axis_cutters_on_analytic_models() {
     let w = Work::new();
@@ -1161,6 +1161,19 @@ fn fixed_axis_cutters_on_analytic_models() {
     for (tip, ..) in &rows {
         let d = tip.x.hypot(tip.y);
         let want = (9.0 - (d - 8.0f64).powi(2)).sqrt() - 2.0;
+        assert!((tip.z - want).abs() < 1e-9, "{tip}: {want}");
+    }
+    // Bull R4 r1.5 in a funnel z = ρ·tan 60° (a cone opening up, half-angle 30°, 20 long): the
+    // far wall through the disc's far edge, tip = (d + 2.5)·tan 60° + 1.5·(1/cos 60° − 1).
+    w.write(
+        "funnel.json",
+        r#"{"surfaces": [{"type": "cone", "apex": [0, 0, 0], "axis": [0, 0, 1], "half_angle": 30, "length": [0, 20]}]}"#,
+    );
+    let th = 60f64.to_radians();
+    let rows = run("funnel.json", "bull.json", &["--region=-2,2,-2,2"]);
+    assert!(rows.len() > 40);
+    for (tip, ..) in &rows {
+        let want = (tip.x.hypot(tip.y) + 2.5) * th.tan() + 1.5 * (1.0 / th.cos() - 1.0);
         assert!((tip.z - want).abs() < 1e-9, "{tip}: {want}");
     }
     w.run(BIN, &["slant.json", "--tool", "flat.json", "--region=-4,4,-6,6", "-o", "f.csv"], b"")

@@ -149,6 +149,39 @@ impl Plane {
     }
 }
 
+/// The upper boundary of the capsule of radius `r` ≥ 0 around the segment `e1`–`e2` (ρ, z) at
+/// `rho`: its height, the nearest point of the segment to it, and the segment's unit normal
+/// pointing up (towards that boundary point where r > 0 and it is not the normal's).
+fn capsule_top(rho: f64, e1: [f64; 2], e2: [f64; 2], r: f64) -> Option<(f64, [f64; 2], [f64; 2])> {
+    let (dr, dz) = (e2[0] - e1[0], e2[1] - e1[1]);
+    let len = dr.hypot(dz);
+    let n = if dr >= 0.0 { [-dz / len, dr / len] } else { [dz / len, -dr / len] };
+    let mut best: Option<(f64, [f64; 2], [f64; 2])> = None;
+    let mut take = |h: f64, foot: [f64; 2], n: [f64; 2]| {
+        if best.is_none_or(|b| h > b.0) {
+            best = Some((h, foot, n));
+        }
+    };
+    // The ends' arcs.
+    for e in [e1, e2] {
+        let off = rho - e[0];
+        if off.abs() <= r {
+            let up = (r * r - off * off).sqrt();
+            let dir = if r > 0.0 { [off / r, up / r] } else { n };
+            take(e[1] + up, e, dir);
+        }
+    }
+    // The side offset by r along the normal (none for a segment along the axis).
+    if dr != 0.0 {
+        let s = (rho - r * n[0] - e1[0]) / dr;
+        if (0.0..=1.0).contains(&s) {
+            let foot = [e1[0] + s * dr, e1[1] + s * dz];
+            take(foot[1] + r * n[1], foot, n);
+        }
+    }
+    best
+}
+
 /// Smallest n.z of a triangle whose plane's drop is taken as a bound of its tips.
 const PLANE_BOUND: f64 = 1e-6;
 
@@ -460,6 +493,32 @@ impl Cutter {
         // The contact: from the tube's centre circle towards the grown torus's point, minor away.
         let s = minor / tube;
         Some((cz + up - r, major + off * s, cz + up * s))
+    }
+
+    /// The drop onto a surface of revolution about an axis parallel to the tool axis whose
+    /// section is the segment `e1`–`e2` (distance from its axis, height; a finite cone's), its
+    /// axis at distance `d` ≥ 0 from the tool axis: the tip and the contact as (signed distance
+    /// from the surface's axis towards the tool axis, height), and the section's unit normal
+    /// there (pointing up); `None` for a cone cutter or where the surface is not under the
+    /// cutter. Exact: a flat, ball or bull-nose is a disc of radius c grown by r, touching where
+    /// the disc touches the surface grown by r, whose section is the segment's capsule of
+    /// radius r and its mirror across the axis; the capsule's upper boundary H is concave, so its
+    /// largest value over the disc's span [d − c, d + c] (from 0) is at its top clamped to it.
+    pub fn drop_section(&self, d: f64, e1: [f64; 2], e2: [f64; 2]) -> Option<(f64, [f64; 2], [f64; 2])> {
+        let (c, r) = self.torus()?;
+        let (lo, hi) = ((d - c).max(0.0), d + c);
+        let top = if e1[1] >= e2[1] { e1[0] } else { e2[0] };
+        let mut best: Option<(f64, [f64; 2], [f64; 2])> = None;
+        // The capsule, then its mirror: H(−ρ) over the span is H over the span mirrored.
+        for (sign, (a, b)) in [(1.0, (lo, hi)), (-1.0, (-hi, -lo))] {
+            let rho = top.clamp(a, b);
+            if let Some((h, foot, n)) = capsule_top(rho, e1, e2, r) {
+                if best.is_none_or(|x| h - r > x.0) {
+                    best = Some((h - r, [sign * foot[0], foot[1]], [sign * n[0], n[1]]));
+                }
+            }
+        }
+        best
     }
 
     /// The model's unit normal at a contact (pointing out of the model, into the cutter) where

@@ -11,8 +11,9 @@
 //! own plane does not. Each corner and edge shared by several triangles is tested in one of
 //! them, and a drop along a line starts from the tip touching the contact before. Planes, spheres and cylinders across or along the axis
 //! have closed forms, and so have a ball on an endless cylinder at a slant and a flat, ball or
-//! bull-nose on a torus along the axis. Other surfaces (cones, other tori and cylinders at a
-//! slant, free-form patches) are refused by [`DropCutter::new`]: tessellate them to STL.
+//! bull-nose on a torus or a finite cone along the axis. Other surfaces (other cones, tori and
+//! cylinders at a slant, free-form patches) are refused by [`DropCutter::new`]: tessellate them
+//! to STL.
 
 use super::analytic::Analytic;
 use super::bvh::{Aabb, Bvh};
@@ -74,6 +75,9 @@ enum Part {
     Slant { point: P3, axis: V3, radius: f64 },
     /// A torus whose axis is along the tool axis, for a flat, ball or bull-nose: centre, radii.
     Torus { centre: P3, major: f64, minor: f64 },
+    /// A finite cone along the tool axis, for a flat, ball or bull-nose: a point of its axis and
+    /// its section's ends (distance from the axis, height).
+    Revolved { centre: P3, ends: [[f64; 2]; 2] },
 }
 
 /// The bits of a point (−0 as 0): equal points give equal drops.
@@ -236,8 +240,19 @@ impl DropCutter {
                         ));
                     }
                 }
-                Geometry::Analytic(Analytic::Cone { .. }) => {
-                    return Err(refuse("cone surfaces are not handled by the drop-cutter: tessellate them to STL"));
+                Geometry::Analytic(Analytic::Cone { apex, axis, half_angle, from, to }) => {
+                    let a = vec(axis);
+                    if a.z.abs() < 1.0 - ACROSS
+                        || !(from.is_finite() && to.is_finite())
+                        || matches!(cutter, Cutter::Cone { .. })
+                    {
+                        return Err(refuse(
+                            "a cone is handled by the drop-cutter only along the tool axis, of finite length, and for a flat, ball or bull-nose cutter: tessellate it to STL",
+                        ));
+                    }
+                    let apex = pt(apex);
+                    let end = |t: f64| [t * half_angle.tan(), apex.z + a.z.signum() * t];
+                    Part::Revolved { centre: apex, ends: [end(*from), end(*to)] }
                 }
                 Geometry::Analytic(Analytic::Torus { centre, axis, major, minor }) => {
                     if vec(axis).z.abs() < 1.0 - ACROSS || matches!(cutter, Cutter::Cone { .. }) {
@@ -395,6 +410,14 @@ impl DropCutter {
                 let core = P3::new(centre.x + ux * major, centre.y + uy * major, centre.z);
                 Some((Touch { tip, contact }, (contact - core) / *minor))
             }
+            Part::Revolved { centre, ends } => {
+                let (dx, dy) = (q[0] - centre.x, q[1] - centre.y);
+                let d = dx.hypot(dy);
+                let (ux, uy) = if d > 0.0 { (dx / d, dy / d) } else { (1.0, 0.0) };
+                let (tip, p, n) = c.drop_section(d, ends[0], ends[1])?;
+                let contact = P3::new(centre.x + ux * p[0], centre.y + uy * p[0], p[1]);
+                Some((Touch { tip, contact }, V3::new(ux * n[0], uy * n[0], n[1])))
+            }
             Part::Rim { centre, radius } => {
                 let (dx, dy) = (q[0] - centre.x, q[1] - centre.y);
                 let d = dx.hypot(dy);
@@ -430,6 +453,11 @@ fn part_bounds(part: &Part) -> Aabb {
         Part::Torus { centre, major, minor } => {
             let e = V3::new(major + minor, major + minor, *minor);
             Aabb { min: centre - e, max: centre + e }
+        }
+        Part::Revolved { centre, ends } => {
+            let r = ends[0][0].max(ends[1][0]);
+            let (z0, z1) = (ends[0][1].min(ends[1][1]), ends[0][1].max(ends[1][1]));
+            Aabb { min: P3::new(centre.x - r, centre.y - r, z0), max: P3::new(centre.x + r, centre.y + r, z1) }
         }
         Part::Rim { centre, radius } => {
             Aabb { min: centre - V3::new(*radius, *radius, 0.0), max: centre + V3::new(*radius, *radius, 0.0) }
@@ -794,6 +822,110 @@ mod tests {
                     let d = (q[0] - 0.5).hypot(q[1] + 0.5);
                     let rim = (d - c.radius() - major - minor).abs().min((d + c.radius() - major + minor).abs());
                     prop_assert!(rim < 10.0 * sagitta, "{g:?} {w:?}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn bull_on_a_cone_along_its_axis_is_the_closed_form() {
+        // A funnel z = ρ·cot 30° (apex at the origin, opening up, 0 ≤ t ≤ 10), bull R 3, r 1 at
+        // distance d from its axis: the far wall, a plane at 60° to the tool axis through the
+        // disc's far edge, gives tip = (d + c)·tan 60° + r·(1/cos 60° − 1), c = 2 (the
+        // plane formula of a bull), while the contact stays on the wall.
+        let m = model(
+            r#"{"surfaces": [{"type": "cone", "apex": [0,0,0], "axis": [0,0,1], "half_angle": 30, "length": [0, 10]}]}"#,
+        );
+        let c = Cutter::Bull { radius: 3.0, corner: 1.0 };
+        let dc = DropCutter::new(&m, c, V3::z()).unwrap();
+        let th = 60f64.to_radians();
+        for d in [0.0, 0.5, 1.5, 2.0] {
+            let want = (d + 2.0) * th.tan() + (1.0 / th.cos() - 1.0);
+            let got = dc.drop(-d, 0.0).unwrap();
+            assert!((got.tip.z - want).abs() < 1e-12, "d {d}: {} vs {want}", got.tip.z);
+            let p = got.contact;
+            assert!((p.x.hypot(p.y) * th.tan() - p.z).abs() < 1e-12, "{p:?}");
+        }
+        // Past the rim (ρ = 10/√3 = 5.77 at height 10) a ball rests on it: its centre is R
+        // from the rim circle, tip = 10 + √(R² − (ρ_q − 5.77)²) − R.
+        let dc = DropCutter::new(&m, Cutter::Ball { radius: 2.0 }, V3::z()).unwrap();
+        let rim = 10.0 * 30f64.to_radians().tan();
+        for e in [0.3, 1.0, 1.9] {
+            let want = 10.0 + (4.0f64 - e * e).sqrt() - 2.0;
+            let got = dc.drop(rim + e, 0.0).unwrap();
+            assert!((got.tip.z - want).abs() < 1e-12, "e {e}: {} vs {want}", got.tip.z);
+            assert!((got.contact - P3::new(rim, 0.0, 10.0)).norm() < 1e-12);
+        }
+        let e = DropCutter::new(&m, Cutter::Cone { radius: 1.0, half_angle: 0.5 }, V3::z()).unwrap_err();
+        assert!(e.what.contains("cone is handled"), "{e:?}");
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(48))]
+        /// Flat, ball and bull-nose on a finite cone along the tool axis (opening up or down)
+        /// against the cone tessellated into 720 strips: on the side the mesh lies and within the
+        /// sagitta over n·z of it, and the contact on the cone.
+        #[test]
+        fn cone_drop_is_within_the_sagitta_of_its_tessellation(
+            c in prop_oneof![
+                (0.3..3.0f64).prop_map(|radius| Cutter::Flat { radius }),
+                (0.3..3.0f64).prop_map(|radius| Cutter::Ball { radius }),
+                (0.3..3.0f64, 0.1..1.0f64).prop_map(|(radius, k)| Cutter::Bull { radius, corner: radius * k }),
+            ],
+            up in prop::bool::ANY,
+            half_angle in 0.2..1.4f64,
+            from in 0.0..3.0f64,
+            length in 0.5..6.0f64,
+            q in prop::array::uniform2(-9.0..9.0f64),
+        ) {
+            let axis = if up { V3::z() } else { -V3::z() };
+            let apex = P3::new(0.5, -0.5, 1.0);
+            let cone = Geometry::Analytic(Analytic::Cone { apex, axis, half_angle, from, to: from + length });
+            let m = Model { surfaces: vec![super::super::Surface::new("k".into(), cone, None, false)] };
+            let got = DropCutter::new(&m, c, V3::z()).unwrap().drop(q[0], q[1]);
+            let n = 720;
+            let at = |k: usize, t: f64| {
+                let th = std::f64::consts::TAU * k as f64 / n as f64;
+                apex + axis * t + V3::new(th.cos(), th.sin(), 0.0) * (t * half_angle.tan())
+            };
+            let mut tris = Vec::new();
+            for k in 0..n {
+                let (t0, t1) = (from, from + length);
+                if t0 > 0.0 {
+                    tris.push([at(k, t0), at(k + 1, t0), at(k + 1, t1)]);
+                }
+                tris.push([at(k, t0), at(k + 1, t1), at(k, t1)]);
+            }
+            let mesh = super::super::mesh::Mesh::new(&tris).unwrap();
+            let mm = Model { surfaces: vec![super::super::Surface::new("m".into(), Geometry::Mesh(mesh), None, false)] };
+            let want = DropCutter::new(&mm, c, V3::z()).unwrap().drop(q[0], q[1]);
+            let rim = (from + length) * half_angle.tan();
+            let sagitta = rim * (1.0 - (std::f64::consts::PI / n as f64).cos());
+            match (got, want) {
+                (None, None) => {}
+                (Some(g), Some(w)) => {
+                    // The strips' chords lie nearer the axis: under a roof (opening down) the
+                    // mesh is inside the cone, in a funnel (opening up) above its wall (at a
+                    // rim circle either, as the rim's polygon lies inside its circle).
+                    let t = (g.contact - apex).dot(&axis);
+                    let wall = t > from + 1e-6 && t < from + length - 1e-6;
+                    if up && wall {
+                        prop_assert!(g.tip.z <= w.tip.z + 1e-9, "exact {} above the mesh's {}", g.tip.z, w.tip.z);
+                    } else if !up && wall {
+                        prop_assert!(g.tip.z >= w.tip.z - 1e-9, "exact {} below the mesh's {}", g.tip.z, w.tip.z);
+                    }
+                    if g.normal.z > 0.05 {
+                        prop_assert!((g.tip.z - w.tip.z).abs() <= sagitta / g.normal.z + 1e-9, "exact {} mesh {}", g.tip.z, w.tip.z);
+                    }
+                    let p = g.contact - apex;
+                    let t = p.dot(&axis);
+                    prop_assert!(t >= from - 1e-9 && t <= from + length + 1e-9);
+                    prop_assert!((V3::new(p.x, p.y, 0.0).norm() - t * half_angle.tan()).abs() < 1e-9);
+                }
+                // Only where the cutter's rim just reaches the cone's rim may one of them miss.
+                (g, w) => {
+                    let d = (q[0] - 0.5).hypot(q[1] + 0.5);
+                    prop_assert!((d - c.radius() - rim).abs() < 10.0 * sagitta, "{g:?} {w:?}");
                 }
             }
         }
