@@ -413,6 +413,27 @@ fn medial_trochoid_takes_its_layers_from_the_setup() {
     w.run("medial-trochoid", &a, b"").fails(2, "--radius 4 disagrees with the radius 5");
 }
 
+/// medial-trochoid's engagement model is a flat end mill's (a disc of the tool's radius cutting
+/// each layer to its floor): a setup whose tool is a cone is refused naming the tool (exit 2),
+/// nothing written.
+#[test]
+fn medial_trochoid_refuses_a_cone_cutter() {
+    let w = Work::new();
+    w.write("tool.json", r#"{"kind": "cone", "radius": 5, "half_angle": 45, "number": 1, "plunge_feed": 200}"#);
+    let contour = data("medial-trochoid/box-die.csv");
+    let contour = contour.to_string_lossy();
+    w.write(
+        "setup.json",
+        format!(
+            r#"{{"tool": "tool.json", "stock": {{"min": [0, 0, 0], "max": [100, 100, 60]}},
+              "part": {{"contours": "{contour}", "floor": 20}}, "clearance_height": 80, "safe_height": 65}}"#
+        ),
+    );
+    w.run("medial-trochoid", &[contour.as_ref(), "--setup", "setup.json", "-o", "out.csv"], b"")
+        .fails(2, "setup.json:1:10 (tool): ./tool.json is a cone cutter: the engagement model is a flat end mill's");
+    assert!(!w.exists("out.csv"));
+}
+
 /// Random passes (polylines at random depths, clear of the walls and the island) in the island
 /// pocket, posted with the setup: every program passes the independent rapid check and the
 /// post's own collision check, with and without ramps. 40 seeded cases.

@@ -1076,7 +1076,8 @@ fn fixed_axis_cutters_agree_with_opencamlib() {
 }
 
 /// Closed forms on analytic models: flat on a sphere, bull on a tilted plane and on a cylinder
-/// across the axis; a ball on a sphere along a slanted axis; the same table for 1 and 2 threads.
+/// across the axis and in a funnel (a cone); a ball on a sphere along a slanted axis, on a slanted
+/// cylinder and on a torus; the same table for 1 and 2 threads.
 #[test]
 fn fixed_axis_cutters_on_analytic_models() {
     let w = Work::new();
@@ -1129,6 +1130,54 @@ fn fixed_axis_cutters_on_analytic_models() {
         assert!((a - axis).norm() < 1e-12);
         assert!(((tip + axis * 2.0).coords.norm() - 12.0).abs() < 1e-9, "{tip}");
     }
+    // Ball R2 on an endless cylinder R3 through the origin along (sin 50°, 0, cos 50°): the
+    // centre (x, y, tip + 2) is 5 from the axis, the higher root; a flat is refused there.
+    let th = 50f64.to_radians();
+    let axis = V3::new(th.sin(), 0.0, th.cos());
+    w.write(
+        "slant.json",
+        format!(
+            r#"{{"surfaces": [{{"type": "cylinder", "point": [0, 0, 0], "axis": [{}, 0, {}], "radius": 3}}]}}"#,
+            th.sin(),
+            th.cos()
+        ),
+    );
+    let rows = run("slant.json", "ball.json", &["--region=-4,4,-4.75,4.75"]);
+    assert!(rows.len() > 300);
+    for (tip, _, contact, n, _) in &rows {
+        // x sin + z cos = t along the axis: |c − t·axis|² = 25 is a quadratic in z.
+        let (x, y) = (tip.x, tip.y);
+        let (a2, b1, c0) = (th.sin().powi(2), -2.0 * x * th.sin() * th.cos(), x * x * th.cos().powi(2) + y * y - 25.0);
+        let want = (-b1 + (b1 * b1 - 4.0 * a2 * c0).sqrt()) / (2.0 * a2) - 2.0;
+        assert!((tip.z - want).abs() < 1e-9, "{tip}: {want}");
+        let radial = |p: &P3| p.coords - axis * p.coords.dot(&axis);
+        assert!((radial(contact).norm() - 3.0).abs() < 1e-9 && (n - radial(contact) / 3.0).norm() < 1e-9);
+    }
+    // Ball R2 on a torus R 8, r 1 about z: the centre is 3 from the tube's centre circle, so
+    // tip = √(9 − (d − 8)²) − 2 at distance d from the torus's axis.
+    w.write("torus.json", r#"{"surfaces": [{"type": "torus", "centre": [0, 0, 0], "axis": [0, 0, 1], "major_radius": 8, "minor_radius": 1}]}"#);
+    let rows = run("torus.json", "ball.json", &["--region=5.5,10.5,-1,1"]);
+    assert!(rows.len() > 40);
+    for (tip, ..) in &rows {
+        let d = tip.x.hypot(tip.y);
+        let want = (9.0 - (d - 8.0f64).powi(2)).sqrt() - 2.0;
+        assert!((tip.z - want).abs() < 1e-9, "{tip}: {want}");
+    }
+    // Bull R4 r1.5 in a funnel z = ρ·tan 60° (a cone opening up, half-angle 30°, 20 long): the
+    // far wall through the disc's far edge, tip = (d + 2.5)·tan 60° + 1.5·(1/cos 60° − 1).
+    w.write(
+        "funnel.json",
+        r#"{"surfaces": [{"type": "cone", "apex": [0, 0, 0], "axis": [0, 0, 1], "half_angle": 30, "length": [0, 20]}]}"#,
+    );
+    let th = 60f64.to_radians();
+    let rows = run("funnel.json", "bull.json", &["--region=-2,2,-2,2"]);
+    assert!(rows.len() > 40);
+    for (tip, ..) in &rows {
+        let want = (tip.x.hypot(tip.y) + 2.5) * th.tan() + 1.5 * (1.0 / th.cos() - 1.0);
+        assert!((tip.z - want).abs() < 1e-9, "{tip}: {want}");
+    }
+    w.run(BIN, &["slant.json", "--tool", "flat.json", "--region=-4,4,-6,6", "-o", "f.csv"], b"")
+        .fails(2, "a cylinder at a slant to the tool axis (handled for a ball cutter on an endless one)");
     let threads = |n: &str| {
         let args = ["--tool", "ball.json", "--pick", "0.5", "--max-step", "0.5", "--axis", "1,-1,2", "--threads", n];
         w.run(BIN, &[&["sphere.json"][..], &args].concat(), b"")
@@ -1152,7 +1201,8 @@ fn fixed_axis_bad_input() {
         .fails(2, "bull.json:1:48 (corner_radius): corner_radius 4 exceeds the radius 3");
     go(&["sphere.json", "--tool", "cone.json"]).fails(2, "cone.json:1:1 (half_angle): a cone cutter needs half_angle");
     go(&["sphere.json", "--tool", "cyl.json"]).fails(2, "does not rotate");
-    go(&["torus.json", "--tool", "ball.json"]).fails(2, "torus.json: surface torus#0: torus surfaces are not handled");
+    go(&["torus.json", "--tool", "ball.json", "--axis", "1,0,1"])
+        .fails(2, "torus.json: surface torus#0: a torus is handled by the drop-cutter only along the tool axis");
     go(&["sphere.json", "--tool", "ball.json", "--mode", "contour"]).fails(2, "--mode scan only");
     go(&["sphere.json", "--tool", "ball.json", "--axis", "0,0,0"]).fails(2, "--axis must be a nonzero direction");
     go(&["sphere.json", "--tool", "ball.json", "--region=20,30,20,30"]).fails(2, "misses the model");

@@ -52,7 +52,8 @@ struct Args {
     radius: Option<f64>,
     /// The job's setup document (docs/formats.md#setup): the tool's radius, and the layers from
     /// the stock top down to the part's floor (`part.floor` of a part given by contours, else the
-    /// contour's z) in equal steps of at most --layer-depth (one layer without it).
+    /// contour's z) in equal steps of at most --layer-depth (one layer without it). A cone tool
+    /// is refused: the engagement model is a flat end mill's.
     #[arg(long, value_name = "FILE", conflicts_with = "layers")]
     setup: Option<String>,
     /// Radial step over between passes (mm); default R(1 − cos threshold), the side cut at the
@@ -210,6 +211,17 @@ fn layering(job: Option<&Job>, contour_z: f64, layers: Option<usize>, depth: f64
 fn run(args: Args) -> Result<()> {
     let started = Instant::now();
     let job = args.setup.as_deref().map(Setup::read).transpose()?;
+    if let Some(j) = job.as_ref().filter(|j| j.tool.kind == camkit::doc::ToolKind::Cone) {
+        // The engagement and material-removal model is a disc of radius R cutting each layer
+        // to its floor, a flat end mill's: a cone is R wide only at its top.
+        return Err(j.error(
+            "tool",
+            format!(
+                "{} is a cone cutter: the engagement model is a flat end mill's (a disc of the tool's radius cutting the whole layer), and a cone cuts a V; use a flat, ball or bull-nose end mill",
+                j.tool_file
+            ),
+        ));
+    }
     let r = match (args.radius, &job) {
         (Some(r), Some(j)) if (r - j.tool.radius).abs() > 1e-12 => {
             return Err(Error::input(format!(

@@ -25,9 +25,13 @@ pub fn drop_lines(dc: &DropCutter, scan: &Scan, step: f64, tick: &(dyn Fn() + Sy
         .map(|line| {
             let mut passes: Vec<Vec<Drop>> = Vec::new();
             let mut open = false;
+            // The contact before, a point of the model: its tip prunes the next drop.
+            let mut near = None;
             for s in stations(line.s0, line.s1, step) {
                 let p = line.at(s, 0.0);
-                match dc.drop(p.x, p.y) {
+                let found = dc.drop_near(p.x, p.y, near);
+                near = found.map(|d| d.contact);
+                match found {
                     Some(d) => {
                         if !open {
                             passes.push(Vec::new());

@@ -178,14 +178,30 @@ impl Bvh {
 }
 
 impl Bvh {
-    /// The largest value over the items by branch and bound: `bound(box)` is an upper bound of
-    /// the values of the items in the box (−∞: none counts), `visit(k)` measures item `k`
+    /// The items (hierarchy order) under each node, by node number (as [`Bvh::maximise`]
+    /// gives it to its bound).
+    pub fn spans(&self) -> Vec<std::ops::Range<usize>> {
+        let mut spans = vec![0..0; self.nodes.len()];
+        // Children come after their parent: fill from the end.
+        for (n, node) in self.nodes.iter().enumerate().rev() {
+            let (s, c) = (node.start as usize, node.count as usize);
+            spans[n] = if c > 0 { s..s + c } else { spans[s].start..spans[s + 1].end };
+        }
+        if self.order.is_empty() {
+            spans[0] = 0..0;
+        }
+        spans
+    }
+
+    /// The largest value over the items by branch and bound: `bound(node, box)` is an upper
+    /// bound of the values of the items under the node (−∞: none counts), `visit(k)` measures
+    /// item `k`
     /// (hierarchy order). Boxes are searched highest bound first and skipped once their bound
     /// is not above the best so far; the first item reaching the largest value wins. `visit` is
     /// given the best value so far (−∞ at first) and may skip an item that cannot beat it.
     pub fn maximise<T>(
         &self,
-        bound: impl Fn(&Aabb) -> f64,
+        bound: impl Fn(usize, &Aabb) -> f64,
         mut visit: impl FnMut(usize, f64) -> Option<(f64, T)>,
     ) -> Option<(f64, T)> {
         let mut best: Option<(f64, T)> = None;
@@ -194,7 +210,7 @@ impl Bvh {
             return None;
         }
         let mut stack: Vec<(u32, f64)> = Vec::with_capacity(64);
-        let root = bound(&self.nodes[0].bounds);
+        let root = bound(0, &self.nodes[0].bounds);
         if beats(root, &best) {
             stack.push((0, root));
         }
@@ -214,7 +230,8 @@ impl Bvh {
                 }
             } else {
                 let (a, c) = (node.start, node.start + 1);
-                let (ba, bc) = (bound(&self.nodes[a as usize].bounds), bound(&self.nodes[c as usize].bounds));
+                let ba = bound(a as usize, &self.nodes[a as usize].bounds);
+                let bc = bound(c as usize, &self.nodes[c as usize].bounds);
                 // The higher bound is pushed last, so searched first.
                 let ((hi, bh), (lo, bl)) = if ba >= bc { ((a, ba), (c, bc)) } else { ((c, bc), (a, ba)) };
                 if beats(bl, &best) {
@@ -278,6 +295,34 @@ mod tests {
             assert!(
                 bvh.nearest(&q, want * 0.99, |k, _| (boxes[bvh.order[k] as usize].min - q).norm_squared()).is_none()
             );
+        }
+    }
+
+    #[test]
+    fn spans_hold_each_nodes_items() {
+        // The root holds every item; each inner node's span is its children's, end to end;
+        // every item lies in its leaf's box.
+        let boxes: Vec<Aabb> = (0..37)
+            .map(|i| {
+                let c = P3::new((i * 7 % 11) as f64, (i * 5 % 13) as f64, (i % 3) as f64);
+                Aabb::of(&[c, c + crate::geom::V3::repeat(0.5)])
+            })
+            .collect();
+        let bvh = Bvh::build(&boxes);
+        let spans = bvh.spans();
+        assert_eq!(spans[0], 0..37);
+        for (n, node) in bvh.nodes.iter().enumerate() {
+            let s = node.start as usize;
+            if node.count == 0 {
+                assert_eq!(
+                    (spans[s].start, spans[s].end, spans[s + 1].end),
+                    (spans[n].start, spans[s + 1].start, spans[n].end)
+                );
+            }
+            for k in spans[n].clone() {
+                let b = boxes[bvh.order[k] as usize];
+                assert_eq!(node.bounds.union(&b), node.bounds);
+            }
         }
     }
 }

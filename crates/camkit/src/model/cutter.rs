@@ -58,6 +58,140 @@ pub struct Touch {
     pub contact: P3,
 }
 
+/// Which corners and edges of a triangle its drop tests (bit k: corner k, edge from corner k to
+/// corner k + 1).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Owned {
+    /// Corners tested here.
+    pub corners: u8,
+    /// Edges tested here.
+    pub edges: u8,
+    /// Edges tested here from corner k + 1 to corner k as well: another triangle runs them that
+    /// way, and the two directions round differently.
+    pub reversed: u8,
+}
+
+impl Owned {
+    /// Every corner and edge, each one way.
+    pub const ALL: Owned = Owned { corners: 0b111, edges: 0b111, reversed: 0 };
+}
+
+/// One way along an edge: its unit direction and length seen along the axis, its slope m and
+/// √(1 + m²) (the same for every drop, so worked out once).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Run {
+    ex: f64,
+    ey: f64,
+    len: f64,
+    m: f64,
+    root: f64,
+}
+
+impl Run {
+    /// From `a` to `b`; `None` for an edge along the axis (its upper corner is the vertex test's).
+    pub fn new(a: &P3, b: &P3) -> Option<Run> {
+        let (ex, ey) = (b.x - a.x, b.y - a.y);
+        let len = ex.hypot(ey);
+        if len <= 1e-12 {
+            return None;
+        }
+        let m = (b.z - a.z) / len;
+        Some(Run { ex: ex / len, ey: ey / len, len, m, root: (1.0 + m * m).sqrt() })
+    }
+
+    /// The other way (bit for bit what [`Run::new`] gives from `b` to `a`).
+    fn reversed(&self) -> Run {
+        Run { ex: -self.ex, ey: -self.ey, len: self.len, m: -self.m, root: self.root }
+    }
+}
+
+/// A triangle ready for drops of one cutter: corners, unit normal (n.z ≥ 0), the features it
+/// tests, its edges' runs and where the cutter touches its plane (what depends on the cutter and
+/// the triangle alone is worked out once).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Facet {
+    /// Corners.
+    pub t: [P3; 3],
+    /// Unit normal with n.z ≥ 0.
+    pub n: V3,
+    /// The corners and edges it tests.
+    pub own: Owned,
+    runs: [Option<Run>; 3],
+    /// Its plane, if not along the axis.
+    plane: Option<Plane>,
+}
+
+impl Facet {
+    /// The triangle `t` of unit normal `n` (n.z ≥ 0) for `cutter`.
+    pub fn new(cutter: &Cutter, t: [P3; 3], n: V3, own: Owned) -> Facet {
+        let runs = [0, 1, 2].map(|k| Run::new(&t[k], &t[(k + 1) % 3]));
+        let plane = (n.z > 1e-12).then(|| Plane::new(cutter, t[0], n));
+        Facet { t, n, own, runs, plane }
+    }
+}
+
+/// A plane not along the axis ready for drops of one cutter: a point, the unit normal (n.z > 0)
+/// and where the cutter touches it ([`Cutter::plane_contact`], and |n.x, n.y|).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Plane {
+    a: P3,
+    n: V3,
+    rho: f64,
+    above: f64,
+    h: f64,
+}
+
+impl Plane {
+    /// The plane through `a` of unit normal `n` (n.z > 0) for `cutter`.
+    pub fn new(cutter: &Cutter, a: P3, n: V3) -> Plane {
+        let (rho, above) = cutter.plane_contact(&n);
+        Plane { a, n, rho, above, h: n.x.hypot(n.y) }
+    }
+}
+
+/// The upper boundary of the capsule of radius `r` ≥ 0 around the segment `e1`–`e2` (ρ, z) at
+/// `rho`: its height, the nearest point of the segment to it, and the segment's unit normal
+/// pointing up (towards that boundary point where r > 0 and it is not the normal's).
+fn capsule_top(rho: f64, e1: [f64; 2], e2: [f64; 2], r: f64) -> Option<(f64, [f64; 2], [f64; 2])> {
+    let (dr, dz) = (e2[0] - e1[0], e2[1] - e1[1]);
+    let len = dr.hypot(dz);
+    let n = if dr >= 0.0 { [-dz / len, dr / len] } else { [dz / len, -dr / len] };
+    let mut best: Option<(f64, [f64; 2], [f64; 2])> = None;
+    let mut take = |h: f64, foot: [f64; 2], n: [f64; 2]| {
+        if best.is_none_or(|b| h > b.0) {
+            best = Some((h, foot, n));
+        }
+    };
+    // The ends' arcs.
+    for e in [e1, e2] {
+        let off = rho - e[0];
+        if off.abs() <= r {
+            let up = (r * r - off * off).sqrt();
+            let dir = if r > 0.0 { [off / r, up / r] } else { n };
+            take(e[1] + up, e, dir);
+        }
+    }
+    // The side offset by r along the normal (none for a segment along the axis).
+    if dr != 0.0 {
+        let s = (rho - r * n[0] - e1[0]) / dr;
+        if (0.0..=1.0).contains(&s) {
+            let foot = [e1[0] + s * dr, e1[1] + s * dz];
+            take(foot[1] + r * n[1], foot, n);
+        }
+    }
+    best
+}
+
+/// Smallest n.z of a triangle whose plane's drop is taken as a bound of its tips.
+const PLANE_BOUND: f64 = 1e-6;
+
+/// The facet test's inside check: `c` lies in the triangle seen along z (either turn).
+fn inside(t: &[P3; 3], c: &P3) -> bool {
+    let side = |a: &P3, b: &P3| (b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x);
+    let (s0, s1, s2) = (side(&t[0], &t[1]), side(&t[1], &t[2]), side(&t[2], &t[0]));
+    (s0 >= 0.0 && s1 >= 0.0 && s2 >= 0.0) || (s0 <= 0.0 && s1 <= 0.0 && s2 <= 0.0)
+}
+
 impl Touch {
     /// The higher of two touches (the first on a tie).
     pub fn max(a: Option<Touch>, b: Option<Touch>) -> Option<Touch> {
@@ -118,14 +252,39 @@ impl Cutter {
     /// The drop onto a triangle (corners `t`, unit normal `n` with n.z ≥ 0) at `q` = (x, y);
     /// edges that cannot give a tip above `floor` are not solved (−∞: every one is).
     pub fn drop_triangle(&self, q: [f64; 2], t: &[P3; 3], n: &V3, floor: f64) -> Option<Touch> {
-        let mut best = None;
-        for p in t {
-            best = Touch::max(best, self.drop_point(q, p));
+        self.drop_facet(q, &Facet::new(self, *t, *n, Owned::ALL), floor)
+    }
+
+    /// The drop onto a triangle testing only the corners and edges it owns (a mesh tests each
+    /// shared one in one triangle); nothing when no tip of the triangle can be above `floor`.
+    pub fn drop_facet(&self, q: [f64; 2], f: &Facet, floor: f64) -> Option<Touch> {
+        let (t, n, own) = (&f.t, &f.n, f.own);
+        let plane = f.plane.as_ref().map(|p| self.drop_on(q, p));
+        // The triangle lies in its plane, so the plane's drop bounds all its tips (taken where
+        // the plane is not near the axis, raised for rounding).
+        if n.z > PLANE_BOUND && plane.is_some_and(|p| p.tip + super::drop::PLANE_MARGIN <= floor) {
+            return None;
         }
-        best = Touch::max(best, self.drop_facet(q, t, n));
+        let mut best = None;
+        for (k, p) in t.iter().enumerate() {
+            if own.corners & (1 << k) != 0 {
+                best = Touch::max(best, self.drop_point(q, p));
+            }
+        }
+        best = Touch::max(best, plane.filter(|p| inside(t, &p.contact)));
         let floor = best.map_or(floor, |b| b.tip.max(floor));
         for k in 0..3 {
-            best = Touch::max(best, self.drop_edge(q, &t[k], &t[(k + 1) % 3], floor));
+            let Some(run) = f.runs[k].filter(|_| own.edges & (1 << k) != 0) else { continue };
+            let (a, b) = (&t[k], &t[(k + 1) % 3]);
+            let e = self.drop_run(q, a, b, &run, floor);
+            best = Touch::max(best, e);
+            // Run the other way the rounding differs (the tip by far less than 1e-9, but at
+            // the rim of a ball an end may fall inside the shadow one way only): solved again
+            // unless its tip is clearly below, so the result is the larger of both as if each
+            // triangle had solved it.
+            if own.reversed & (1 << k) != 0 && e.is_none_or(|e| e.tip >= floor - 1e-9) {
+                best = Touch::max(best, self.drop_run(q, b, a, &run.reversed(), floor));
+            }
         }
         best
     }
@@ -155,35 +314,27 @@ impl Cutter {
     /// The drop onto the plane through `a` with unit normal `n` (n.z > 0) at `q`: the tip and
     /// the contact point.
     pub fn drop_plane(&self, q: [f64; 2], a: &P3, n: &V3) -> Touch {
-        let (rho, above) = self.plane_contact(n);
-        let h = n.x.hypot(n.y);
+        self.drop_on(q, &Plane::new(self, *a, *n))
+    }
+
+    /// [`Cutter::drop_plane`] onto a prepared plane.
+    pub fn drop_on(&self, q: [f64; 2], p: &Plane) -> Touch {
+        let Plane { a, n, rho, above, h } = p;
+        let (rho, above, h) = (*rho, *above, *h);
         let (cx, cy) = if rho > 0.0 { (q[0] - rho * n.x / h, q[1] - rho * n.y / h) } else { (q[0], q[1]) };
         let z = a.z - (n.x * (cx - a.x) + n.y * (cy - a.y)) / n.z;
         Touch { tip: z - above, contact: P3::new(cx, cy, z) }
     }
 
-    /// The facet test: the plane's touch, if its contact lies inside the triangle (seen along z).
-    fn drop_facet(&self, q: [f64; 2], t: &[P3; 3], n: &V3) -> Option<Touch> {
-        if n.z <= 1e-12 {
-            return None;
-        }
-        let touch = self.drop_plane(q, &t[0], n);
-        let c = touch.contact;
-        let side = |a: &P3, b: &P3| (b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x);
-        let (s0, s1, s2) = (side(&t[0], &t[1]), side(&t[1], &t[2]), side(&t[2], &t[0]));
-        let inside = (s0 >= 0.0 && s1 >= 0.0 && s2 >= 0.0) || (s0 <= 0.0 && s1 <= 0.0 && s2 <= 0.0);
-        inside.then_some(touch)
-    }
-
     /// The edge test: the largest g along the edge from `a` to `b` within the shadow, if it can
     /// be above `floor`.
     pub fn drop_edge(&self, q: [f64; 2], a: &P3, b: &P3, floor: f64) -> Option<Touch> {
-        let (ex, ey) = (b.x - a.x, b.y - a.y);
-        let len = ex.hypot(ey);
-        if len <= 1e-12 {
-            return None; // along the axis: its upper corner is the vertex test's
-        }
-        let (ex, ey) = (ex / len, ey / len);
+        self.drop_run(q, a, b, &Run::new(a, b)?, floor)
+    }
+
+    /// [`Cutter::drop_edge`] given the edge's [`Run`].
+    fn drop_run(&self, q: [f64; 2], a: &P3, b: &P3, run: &Run, floor: f64) -> Option<Touch> {
+        let Run { ex, ey, len, m, root } = *run;
         // s along the edge from the foot of q, d the distance of q from the edge's line.
         let s1 = (a.x - q[0]) * ex + (a.y - q[1]) * ey;
         let d = ((a.x - q[0]) * ey - (a.y - q[1]) * ex).abs();
@@ -198,7 +349,6 @@ impl Cutter {
         if lo > hi {
             return None;
         }
-        let m = (b.z - a.z) / len;
         let z = |s: f64| a.z + m * (s - s1);
         let g = |s: f64| z(s) - self.height(d.hypot(s).min(big_r));
         let s = match *self {
@@ -209,7 +359,7 @@ impl Cutter {
                     lo
                 }
             }
-            Cutter::Ball { .. } => (m * w / (1.0 + m * m).sqrt()).clamp(lo, hi),
+            Cutter::Ball { .. } => (m * w / root).clamp(lo, hi),
             Cutter::Cone { half_angle, .. } => {
                 let k = m * half_angle.tan();
                 if k >= 1.0 {
@@ -233,6 +383,24 @@ impl Cutter {
                 } else if db >= 0.0 {
                     hi
                 } else {
+                    // g lies under its tangents at both ends (concave): where they meet bounds
+                    // it (a vertical tangent at the rim bounds nothing), 1e-9 up for rounding.
+                    let (ga, gb, span) = (g(lo), g(hi), hi - lo);
+                    let bound = if da.is_finite() && db.is_finite() {
+                        // They meet at lo + x, x = (gb − ga − g′(b)·span) / (g′(a) − g′(b)),
+                        // written so the rounding is relative to the rise above ga.
+                        let meet = ga + (gb - ga - db * span) * (da / (da - db));
+                        meet.min(ga + da * span).min(gb - db * span)
+                    } else if da.is_finite() {
+                        ga + da * span
+                    } else if db.is_finite() {
+                        gb - db * span
+                    } else {
+                        f64::INFINITY
+                    };
+                    if bound + 1e-9 <= floor {
+                        return None;
+                    }
                     // The largest g lies under the tangents at both ends: at most
                     // min(g′(a), −g′(b))·(b − a) above the better end.
                     for _ in 0..200 {
@@ -304,6 +472,53 @@ impl Cutter {
                 Some((cz + up - r, d - m * s, cz + up * s))
             }
         }
+    }
+
+    /// The drop onto a torus whose axis is the tool axis's direction, its centre at distance
+    /// `d` ≥ 0 from the tool axis and height `cz`: the tip and the contact as (distance from the
+    /// torus's axis towards the tool axis, height); `None` for a cone (not handled) or where the
+    /// torus is not under the cutter. Exact: a flat, ball or bull-nose is a disc of radius c grown
+    /// by r, so it touches the torus where the disc touches the torus grown by r (its tube
+    /// `minor` + r), whose height at distance ρ from its axis depends on ρ alone and is highest
+    /// at ρ = `major`; the disc spans ρ over [d − c, d + c] (from 0 if it holds the axis).
+    pub fn drop_torus(&self, d: f64, cz: f64, major: f64, minor: f64) -> Option<(f64, f64, f64)> {
+        let (c, r) = self.torus()?;
+        let tube = minor + r;
+        let rho = major.clamp((d - c).max(0.0), d + c);
+        let off = rho - major;
+        if off.abs() > tube {
+            return None;
+        }
+        let up = (tube * tube - off * off).sqrt();
+        // The contact: from the tube's centre circle towards the grown torus's point, minor away.
+        let s = minor / tube;
+        Some((cz + up - r, major + off * s, cz + up * s))
+    }
+
+    /// The drop onto a surface of revolution about an axis parallel to the tool axis whose
+    /// section is the segment `e1`–`e2` (distance from its axis, height; a finite cone's), its
+    /// axis at distance `d` ≥ 0 from the tool axis: the tip and the contact as (signed distance
+    /// from the surface's axis towards the tool axis, height), and the section's unit normal
+    /// there (pointing up); `None` for a cone cutter or where the surface is not under the
+    /// cutter. Exact: a flat, ball or bull-nose is a disc of radius c grown by r, touching where
+    /// the disc touches the surface grown by r, whose section is the segment's capsule of
+    /// radius r and its mirror across the axis; the capsule's upper boundary H is concave, so its
+    /// largest value over the disc's span [d − c, d + c] (from 0) is at its top clamped to it.
+    pub fn drop_section(&self, d: f64, e1: [f64; 2], e2: [f64; 2]) -> Option<(f64, [f64; 2], [f64; 2])> {
+        let (c, r) = self.torus()?;
+        let (lo, hi) = ((d - c).max(0.0), d + c);
+        let top = if e1[1] >= e2[1] { e1[0] } else { e2[0] };
+        let mut best: Option<(f64, [f64; 2], [f64; 2])> = None;
+        // The capsule, then its mirror: H(−ρ) over the span is H over the span mirrored.
+        for (sign, (a, b)) in [(1.0, (lo, hi)), (-1.0, (-hi, -lo))] {
+            let rho = top.clamp(a, b);
+            if let Some((h, foot, n)) = capsule_top(rho, e1, e2, r) {
+                if best.is_none_or(|x| h - r > x.0) {
+                    best = Some((h - r, [sign * foot[0], foot[1]], [sign * n[0], n[1]]));
+                }
+            }
+        }
+        best
     }
 
     /// The model's unit normal at a contact (pointing out of the model, into the cutter) where
