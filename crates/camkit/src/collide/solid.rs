@@ -570,6 +570,12 @@ impl Solid {
                         true,
                     )?)
                 }
+                Geometry::Face(_) => {
+                    return Err(format!(
+                        "surface {} is a trimmed STEP face: the collision check takes meshes, B-spline patches, spheres and planes; give the part as an STL",
+                        s.name
+                    ));
+                }
                 Geometry::Analytic(a) => {
                     let what = match a {
                         Analytic::Sphere { .. } => "a sphere with its normal flipped (material outside it)",
