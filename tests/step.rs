@@ -30,6 +30,9 @@ fn p3(row: &[(String, String)], x: &str, y: &str, z: &str) -> P3 {
     P3::new(num(row, x), num(row, y), num(row, z))
 }
 
+/// The signed distance of a point from a closed-form surface.
+type Offset = dyn Fn(&P3) -> f64;
+
 /// Traces `model` (a path under data/) over `region` with a stylus of radius 3.
 fn trace(w: &Work, model: &str, region: &str, out: &str) -> Vec<Vec<(String, String)>> {
     let m = data(model).display().to_string();
@@ -45,7 +48,7 @@ fn trace(w: &Work, model: &str, region: &str, out: &str) -> Vec<Vec<(String, Str
 #[test]
 fn step_faces_agree_with_the_analytic_model() {
     let w = Work::new();
-    let cases: [(&str, &dyn Fn(&P3) -> f64); 3] = [
+    let cases: [(&str, &Offset); 3] = [
         ("-15,15,-15,15", &|c: &P3| c.coords.norm() - 20.0),
         ("45,95,-12,12", &|c: &P3| c.y.hypot(c.z) - 10.0),
         ("-14,14,48,72", &|c: &P3| (c.x.hypot(c.y - 60.0) - 10.0).hypot(c.z) - 6.0),
@@ -176,4 +179,17 @@ fn bad_step_input_is_refused_with_one_line() {
     o.ok();
     assert!(o.stderr.contains("warning") && o.stderr.contains("face #323 left out"), "{}", o.stderr);
     assert_eq!(o.stderr.trim_end().lines().count(), 1, "{}", o.stderr);
+}
+
+/// tool-attitude reads a STEP model but its gouge check (the collision solid) does not take
+/// trimmed faces yet: refused in one line, exit 2, naming the file and the face.
+#[test]
+fn tool_attitude_refuses_step_faces_for_its_gouge_check() {
+    let w = Work::new();
+    w.write("c.csv", "path,x,y,z,px,py,pz,nx,ny,nz\n0,50,50,45,50,50,30,0,0,1\n");
+    w.write("ball.json", r#"{"kind": "ball", "radius": 3}"#);
+    let m = data("step/block.step").display().to_string();
+    w.run("tool-attitude", &["c.csv", "--tool", "ball.json", "--model", &m, "-o", "t.csv"], b"")
+        .fails(2, "block.step: surface plane#17 is a trimmed STEP face: the collision check takes");
+    assert!(!w.exists("t.csv"));
 }

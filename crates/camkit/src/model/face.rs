@@ -69,12 +69,12 @@ impl SplineCurve {
         let s = find_span(&self.knots, n, p, t);
         let b = basis_derivs(&self.knots, s, p, t);
         let (mut a, mut w) = ([V3::zeros(); 3], [0.0; 3]);
-        for j in 0..=p {
-            let k = s - p + j;
+        for k in s - p..=s {
             let wk = self.weights.as_ref().map_or(1.0, |ws| ws[k]);
-            for d in 0..3 {
-                a[d] += self.ctrl[k].coords * (wk * b[d][j]);
-                w[d] += wk * b[d][j];
+            for ((ad, wd), bd) in a.iter_mut().zip(w.iter_mut()).zip(&b) {
+                let basis = wk * bd[k + p - s];
+                *ad += self.ctrl[k].coords * basis;
+                *wd += basis;
             }
         }
         let c = a[0] / w[0];
