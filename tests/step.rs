@@ -181,15 +181,39 @@ fn bad_step_input_is_refused_with_one_line() {
     assert_eq!(o.stderr.trim_end().lines().count(), 1, "{}", o.stderr);
 }
 
-/// tool-attitude reads a STEP model but its gouge check (the collision solid) does not take
-/// trimmed faces yet: refused in one line, exit 2, naming the file and the face.
+/// tool-attitude with --model on the STEP block: the ball end mill on the CL of the dish is
+/// clear (no row deeper than the gouge tolerance, the deepest within the faces' triangles' chord),
+/// and a contact moved 0.1 mm down is found gouging by 0.1·n_z (the normal's z), within the chord.
 #[test]
-fn tool_attitude_refuses_step_faces_for_its_gouge_check() {
+fn tool_attitude_gouge_checks_against_step_faces() {
     let w = Work::new();
-    w.write("c.csv", "path,x,y,z,px,py,pz,nx,ny,nz\n0,50,50,45,50,50,30,0,0,1\n");
-    w.write("ball.json", r#"{"kind": "ball", "radius": 3}"#);
     let m = data("step/block.step").display().to_string();
-    w.run("tool-attitude", &["c.csv", "--tool", "ball.json", "--model", &m, "-o", "t.csv"], b"")
-        .fails(2, "block.step: surface plane#17 is a trimmed STEP face: the collision check takes");
-    assert!(!w.exists("t.csv"));
+    w.run(BIN, &[&m, "-r", "3", "--pick", "5", "--region=30,70,30,70", "-q", "-o", "cl.csv"], b"").ok();
+    w.write("ball.json", r#"{"kind": "ball", "radius": 3}"#);
+    let args =
+        |input: &'static str| vec![input, "--tool", "ball.json", "--model", &m, "-o", "t.csv", "--report", "r.json"];
+    w.run("tool-attitude", &args("cl.csv"), b"").ok();
+    let r: serde_json::Value = serde_json::from_str(&w.read("r.json")).unwrap();
+    let chord = r["gouge_chord_mm"].as_f64().unwrap();
+    assert!(chord > 0.0 && chord < 1e-3, "{r}");
+    assert_eq!(r["gouge_rows"], 0, "{r}");
+    assert!(r["largest_gouge_mm"].as_f64().unwrap() <= chord + 1e-9, "{r}");
+    // One contact 0.1 mm lower.
+    let cl = w.read("cl.csv");
+    let rows = table(&cl);
+    let k = rows.len() / 2;
+    let nz = num(&rows[k], "nz");
+    let mut lines: Vec<String> = cl.lines().map(str::to_string).collect();
+    let header: Vec<&str> = lines[0].split(',').collect();
+    let (iz, ipz) = (header.iter().position(|h| *h == "z").unwrap(), header.iter().position(|h| *h == "pz").unwrap());
+    let mut f: Vec<String> = lines[k + 1].split(',').map(str::to_string).collect();
+    for i in [iz, ipz] {
+        f[i] = (f[i].parse::<f64>().unwrap() - 0.1).to_string();
+    }
+    lines[k + 1] = f.join(",");
+    w.write("low.csv", lines.join("\n") + "\n");
+    let o = w.run("tool-attitude", &args("low.csv"), b"");
+    o.fails(1, &format!("low.csv:{}: 1 row(s) gouge the model by more than 0.001 mm", k + 2));
+    let deepest: f64 = o.stderr.split("deepest ").nth(1).unwrap().trim_end().trim_end_matches(" mm)").parse().unwrap();
+    assert!((deepest - 0.1 * nz).abs() <= chord + 1e-6, "deepest {deepest} vs {}", 0.1 * nz);
 }

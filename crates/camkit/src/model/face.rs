@@ -408,6 +408,26 @@ impl Carrier {
         }
     }
 
+    /// The point at (u, v).
+    fn point(&self, [u, v]: [f64; 2]) -> P3 {
+        match self {
+            Carrier::Analytic(Analytic::Plane { .. }) => P3::new(u, v, 0.0),
+            Carrier::Analytic(Analytic::Cylinder { radius, .. }) => P3::new(radius * u.cos(), radius * u.sin(), v),
+            Carrier::Analytic(Analytic::Cone { apex, half_angle, .. }) => {
+                let rho = (v - apex.z) * half_angle.tan();
+                P3::new(rho * u.cos(), rho * u.sin(), v)
+            }
+            Carrier::Analytic(Analytic::Sphere { radius, .. }) => {
+                P3::new(radius * v.cos() * u.cos(), radius * v.cos() * u.sin(), radius * v.sin())
+            }
+            Carrier::Analytic(Analytic::Torus { major, minor, .. }) => {
+                let rho = major + minor * v.cos();
+                P3::new(rho * u.cos(), rho * u.sin(), minor * v.sin())
+            }
+            Carrier::Patch(s) => s.eval(u, v).s,
+        }
+    }
+
     /// The carrier's normal at a point on it.
     fn normal_at(&self, p: &P3) -> V3 {
         match self {
@@ -537,6 +557,89 @@ impl Face {
         }
         let below = (-(self.sense as i32) * wraps).max(0);
         self.sense as i32 * w + below >= 1
+    }
+
+    /// Triangles covering the face (face frame, turned so that their right-hand normals follow
+    /// the carrier's) and the largest distance found between them and the surface: a constrained
+    /// Delaunay triangulation (`spade`) in (u, v) of the loops (as constraints) and a grid of
+    /// points, the grid halved until that distance is below `chord` (at most 512 × 512); the
+    /// triangles whose middle is inside the face are kept. The boundary is the loops' polygon.
+    pub fn triangles(&self, chord: f64) -> (Vec<[P3; 3]>, f64) {
+        use spade::{ConstrainedDelaunayTriangulation, Point2, Triangulation};
+        let periodic = self.carrier.periodic();
+        let pts = || self.loops.iter().flat_map(|l| l.segs.iter().flat_map(|(a, b)| [*a, *b]));
+        let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+        for p in pts() {
+            for c in 0..2 {
+                lo[c] = lo[c].min(p[c]);
+                hi[c] = hi[c].max(p[c]);
+            }
+        }
+        if self.loops.iter().any(|l| l.wraps != 0) {
+            hi[0] = hi[0].max(lo[0] + TAU);
+            if let Carrier::Analytic(Analytic::Sphere { .. }) = self.carrier {
+                // Out to the pole the face holds.
+                if self.inside([lo[0], -PI / 2.0]) {
+                    lo[1] = -PI / 2.0;
+                }
+                if self.inside([lo[0], PI / 2.0]) {
+                    hi[1] = PI / 2.0;
+                }
+            }
+        }
+        if periodic[1] && (hi[1] - lo[1]) > TAU {
+            hi[1] = lo[1] + TAU;
+        }
+        let mut n = 16usize;
+        loop {
+            let mut cdt = ConstrainedDelaunayTriangulation::<Point2<f64>>::new();
+            let mut put = |p: [f64; 2]| cdt.insert(Point2::new(p[0], p[1])).ok();
+            for i in 0..=n {
+                for j in 0..=n {
+                    let f = [i as f64 / n as f64, j as f64 / n as f64];
+                    put([lo[0] + (hi[0] - lo[0]) * f[0], lo[1] + (hi[1] - lo[1]) * f[1]]);
+                }
+            }
+            let mut constraints = Vec::new();
+            for l in &self.loops {
+                for (a, b) in &l.segs {
+                    if let (Some(a), Some(b)) = (put(*a), put(*b)) {
+                        constraints.push((a, b));
+                    }
+                }
+            }
+            for (a, b) in constraints {
+                if a != b {
+                    cdt.try_add_constraint(a, b);
+                }
+            }
+            let mut tris = Vec::new();
+            let mut worst = 0.0f64;
+            for f in cdt.inner_faces() {
+                let uv = f.vertices().map(|v| [v.position().x, v.position().y]);
+                let mid = [(uv[0][0] + uv[1][0] + uv[2][0]) / 3.0, (uv[0][1] + uv[1][1] + uv[2][1]) / 3.0];
+                if !self.inside(mid) {
+                    continue;
+                }
+                let t = uv.map(|q| self.carrier.point(q));
+                let nrm = (t[1] - t[0]).cross(&(t[2] - t[0]));
+                let len = nrm.norm();
+                if len <= 1e-12 {
+                    continue; // collapsed at a pole or an apex
+                }
+                for k in 0..3 {
+                    let e = [(uv[k][0] + uv[(k + 1) % 3][0]) / 2.0, (uv[k][1] + uv[(k + 1) % 3][1]) / 2.0];
+                    for q in [e, mid] {
+                        worst = worst.max(((self.carrier.point(q) - t[0]).dot(&nrm) / len).abs());
+                    }
+                }
+                tris.push(t);
+            }
+            if worst <= chord || n >= 512 {
+                return (tris, worst);
+            }
+            n *= 2;
+        }
     }
 
     /// The nearest point of the face to `q` no farther than `bound`, the carrier's normal there
@@ -689,6 +792,40 @@ mod tests {
         let q = P3::new(0.0, 30.0, -4.0);
         let (f, _) = face.nearest(&q, f64::INFINITY).unwrap();
         assert!((f.point - P3::new(0.0, 25.0, 0.0)).norm() < 1e-12, "{}", f.point);
+    }
+
+    /// The triangles of a plane with a hole cover its area less the hole's (the hole's polygon),
+    /// face up; those of the dish lie on the sphere below the rim, within the chord.
+    #[test]
+    fn triangles_cover_the_face() {
+        let plane = Carrier::Analytic(Analytic::Plane { point: P3::origin(), normal: V3::z() });
+        let face = Face::new(plane, vec![square(50.0), vec![(circle(P3::origin(), 10.0), false)]], true);
+        let (tris, dev) = face.triangles(1e-6);
+        let area: f64 = tris.iter().map(|t| 0.5 * (t[1] - t[0]).cross(&(t[2] - t[0])).z).sum();
+        let n = (TAU / ARC_STEP).round();
+        let hole = 0.5 * n * 100.0 * (TAU / n).sin();
+        assert!((area - (1e4 - hole)).abs() < 1e-6 && dev < 1e-9, "{area} vs {}", 1e4 - hole);
+        assert!(tris.iter().all(|t| (t[0] + t[1].coords + t[2].coords).coords.xy().norm() / 3.0 > 9.9));
+        let (r, h) = (40.0f64, 30.0f64);
+        let sphere = Carrier::Analytic(Analytic::Sphere { centre: P3::origin(), radius: r });
+        let rim = circle(P3::new(0.0, 0.0, -h), (r * r - h * h).sqrt());
+        let seam =
+            Curve::Arc { centre: P3::origin(), x: V3::x(), y: -V3::z(), radius: r, t0: (h / r).asin(), t1: PI / 2.0 };
+        let dish = Face::new(sphere, vec![vec![(rim, true), (seam.clone(), true), (seam, false)]], false);
+        let (tris, dev) = dish.triangles(1e-3);
+        assert!(dev <= 1e-3 && tris.len() > 100, "{dev}");
+        for t in &tris {
+            for p in t {
+                assert!((p.coords.norm() - r).abs() < 1e-9 && p.z <= -h + 1e-9, "{p}");
+            }
+            // Turned with the carrier's normal (outward from the centre).
+            let c = (t[0].coords + t[1].coords + t[2].coords) / 3.0;
+            assert!((t[1] - t[0]).cross(&(t[2] - t[0])).dot(&c) > 0.0);
+        }
+        // Together they cover the cap: 2πR(R − h) less the chord's shortfall.
+        let area: f64 = tris.iter().map(|t| 0.5 * (t[1] - t[0]).cross(&(t[2] - t[0])).norm()).sum();
+        let cap = TAU * r * (r - h);
+        assert!(area < cap && area > cap * 0.999, "{area} vs {cap}");
     }
 
     #[test]
