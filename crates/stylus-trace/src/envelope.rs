@@ -9,6 +9,7 @@
 
 use camkit::geom::{P3, V3};
 use camkit::model::analytic::Analytic;
+use camkit::model::face::{Carrier, Curve, Face};
 use camkit::model::{Geometry, Model, Surface};
 
 /// A triangle in the model's frame with its unit normal.
@@ -47,6 +48,15 @@ enum Part<'a> {
         point: P3,
         axis: V3,
         radius: f64,
+    },
+    /// A trimmed face on a plane or a sphere, or round a vertical axis: the stylus rests on its
+    /// inside where its carrier's contact (closed form; none on a vertical wall, where an inner
+    /// contact raised stays a contact) lies in the face, else on its boundary edges (segments and
+    /// horizontal arcs exactly, other curves by the search). Never a search on the face itself,
+    /// whose distance is flat along a wall.
+    Face {
+        surface: &'a Surface,
+        face: &'a Face,
     },
     /// Anything else: searched on its own exact distance between these heights of the centre.
     Search {
@@ -104,6 +114,17 @@ impl<'a> Dropper<'a> {
                     for rr in [radius + r, radius - r].into_iter().filter(|rr| *rr >= 0.0) {
                         if let Some(t) = line_tube(&P3::new(x, y, point.z), point, axis, rr) {
                             take(&mut best, point.z + t);
+                        }
+                    }
+                }
+                Part::Face { surface, face } => {
+                    for z in face_contacts(surface, face, x, y, r) {
+                        take(&mut best, z);
+                    }
+                    let place = |p: P3| surface.placement.map_or(p, |iso| iso * p);
+                    for curve in face.edges() {
+                        if let Some(z) = self.drop_on_curve(surface, curve, &place, x, y, best) {
+                            take(&mut best, z);
                         }
                     }
                 }
@@ -178,6 +199,13 @@ fn part(s: &Surface, r: f64) -> Part<'_> {
         {
             Part::Cylinder { point: to_model(*point), axis: dir(*axis), radius: *radius }
         }
+        Geometry::Face(face) => match face.carrier() {
+            Carrier::Analytic(Analytic::Plane { .. } | Analytic::Sphere { .. }) => Part::Face { surface: s, face },
+            Carrier::Analytic(Analytic::Cylinder { axis, .. }) if dir(*axis).z.abs() >= 1.0 - 1e-12 => {
+                Part::Face { surface: s, face }
+            }
+            _ => search(),
+        },
         _ => search(),
     }
 }
@@ -288,6 +316,114 @@ fn drop_on_triangle(t: &Tri, x: f64, y: f64, r: f64) -> Option<f64> {
             if (0.0..=len).contains(&along) {
                 take(c.z);
             }
+        }
+    }
+    best
+}
+
+/// Heights over (x, y) at which a stylus of radius r touches the inside of a plane or sphere face
+/// (every tangency with the carrier whose contact lies in the face; none for a vertical wall).
+fn face_contacts(s: &Surface, face: &Face, x: f64, y: f64, r: f64) -> Vec<f64> {
+    let to_local = |p: P3| s.placement.map_or(p, |iso| iso.inverse_transform_point(&p));
+    let to_model = |p: P3| s.placement.map_or(p, |iso| iso * p);
+    let up = s.placement.map_or(V3::z(), |iso| iso.inverse_transform_vector(&V3::z()));
+    let base = to_local(P3::new(x, y, 0.0));
+    // Centre heights t (model z) with the contact point (face frame) of each tangency.
+    let mut found = Vec::new();
+    match face.carrier() {
+        Carrier::Analytic(Analytic::Plane { .. }) if up.z.abs() > 1e-12 => {
+            // Local plane z = 0: the centre at local z = ±r.
+            for side in [r, -r] {
+                let t = (side - base.z) / up.z;
+                let c = base + up * t;
+                found.push((t, P3::new(c.x, c.y, 0.0)));
+            }
+        }
+        Carrier::Analytic(Analytic::Sphere { radius, .. }) => {
+            // Local centre at the origin: |base + t·up| = R ± r.
+            let (b, c0) = (base.coords.dot(&up), base.coords.norm_squared());
+            for rr in [radius + r, (radius - r).abs()] {
+                let disc = b * b - (c0 - rr * rr);
+                if disc >= 0.0 {
+                    for t in [-b + disc.sqrt(), -b - disc.sqrt()] {
+                        let c = base + up * t;
+                        if let Some(u) = c.coords.try_normalize(1e-300) {
+                            found.push((t, P3::from(u * *radius)));
+                        }
+                    }
+                }
+            }
+        }
+        _ => {}
+    }
+    found.into_iter().filter(|(_, p)| face.contains(p)).map(|(t, _)| to_model(base + up * t).z).collect()
+}
+
+impl Dropper<'_> {
+    /// The highest centre z over (x, y) touching a boundary curve of a face, above `best`:
+    /// segments and horizontal arcs in closed form, other curves by the certified search.
+    fn drop_on_curve(
+        &self,
+        s: &Surface,
+        curve: &Curve,
+        place: &dyn Fn(P3) -> P3,
+        x: f64,
+        y: f64,
+        best: Option<f64>,
+    ) -> Option<f64> {
+        let r = self.radius;
+        let local = |q: P3| s.placement.map_or(q, |iso| iso.inverse_transform_point(&q));
+        match curve {
+            Curve::Line { a, b } => drop_on_segment(&place(*a), &place(*b), x, y, r),
+            Curve::Arc { centre, x: ax, y: ay, .. }
+                if (place(centre + ax).z - place(*centre).z).abs() <= 1e-12
+                    && (place(centre + ay).z - place(*centre).z).abs() <= 1e-12 =>
+            {
+                // A horizontal arc: its nearest point to the vertical is the same at every height.
+                let zc = place(*centre).z;
+                let q = P3::new(x, y, zc);
+                let h = (place(curve.nearest(&local(q)).0) - q).norm();
+                (h <= r).then(|| zc + (r * r - h * h).sqrt())
+            }
+            _ => {
+                let b = curve.bounds();
+                let (z0, z1) = (0..8)
+                    .map(|k| {
+                        place(P3::new(
+                            if k & 1 == 0 { b.min.x } else { b.max.x },
+                            if k & 2 == 0 { b.min.y } else { b.max.y },
+                            if k & 4 == 0 { b.min.z } else { b.max.z },
+                        ))
+                        .z
+                    })
+                    .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), z| (lo.min(z), hi.max(z)));
+                let lo = best.map_or(z0 - r, |bz| bz.max(z0 - r));
+                let f = |z: f64| {
+                    let q = local(P3::new(x, y, z));
+                    Some((curve.nearest(&q).0 - q).norm() - r)
+                };
+                highest_root(&f, lo, z1 + r, self.tol)
+            }
+        }
+    }
+}
+
+/// The highest centre z over (x, y) at which a sphere of radius r touches the segment a–b: its
+/// ends, or its inside (the vertical's upper crossing with the tube round it).
+fn drop_on_segment(a: &P3, b: &P3, x: f64, y: f64, r: f64) -> Option<f64> {
+    let mut best: Option<f64> = None;
+    for c in [a, b] {
+        let rho2 = (x - c.x).powi(2) + (y - c.y).powi(2);
+        if rho2 <= r * r {
+            raise(&mut best, c.z + (r * r - rho2).sqrt());
+        }
+    }
+    let len = (b - a).norm();
+    let d = (b - a) / len;
+    if let Some(tz) = line_tube(&P3::new(x, y, a.z), a, &d, r) {
+        let c = P3::new(x, y, a.z + tz);
+        if (0.0..=len).contains(&(c - a).dot(&d)) {
+            raise(&mut best, c.z);
         }
     }
     best

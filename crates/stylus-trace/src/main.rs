@@ -36,7 +36,7 @@ pub(crate) enum ModeArg {
     allow_negative_numbers = true,
     about = "Copy simulation: a virtual stylus traces a defined model and yields CL data with no offset surface.",
     long_about = "Copy simulation (paper 000 §3.1-3.2): a virtual stylus, a sphere of radius r, traces a defined \
-model (a model JSON document or an STL file). L runs from the nearest point of the whole model to the stylus centre; \
+model (a model JSON document, an STL file or a STEP file's trimmed faces). L runs from the nearest point of the whole model to the stylus centre; \
 ΔR = (r − |L|)·L/|L| is corrected inside the motion plane until |ΔR| ≤ --contact-tol, then the stylus steps on, \
 each step as long as keeps the chord within --chord-tol of the true CL curve. Every CL point is measured again \
 against the whole model before anything is written: no point is closer than r − --contact-tol to any part of it.",
@@ -113,6 +113,10 @@ pub(crate) struct Args {
     /// Refuse an STL file with zero-area or repeated facets (default: they are left out, with a warning).
     #[arg(long)]
     strict: bool,
+    /// A STEP model's faces on surfaces or edges the reader does not take are left out, with a
+    /// warning each (default: the first is refused, naming the entity and its #id).
+    #[arg(long)]
+    skip_unsupported: bool,
     /// Largest memory (MB: CL points, their rows, the scan lines), estimated before the run; more is refused.
     #[arg(long, default_value_t = budget::DEFAULT_MEMORY_MB, value_name = "MB")]
     max_memory: u64,
@@ -122,8 +126,11 @@ pub(crate) struct Args {
 }
 
 fn after_help() -> String {
-    let mut s =
-        String::from("Input: a model JSON document (docs/formats.md, `model`) or an STL file (binary or ASCII).\n\n");
+    let mut s = String::from(
+        "Input: a model JSON document (docs/formats.md, `model`), an STL file (binary or ASCII), or a STEP file\n\
+(.step/.stp, AP203/AP214/AP242 B-rep: planes, cylinders, cones, spheres, tori and B-spline surfaces, exact and\n\
+trimmed by their edges).\n\n",
+    );
     s.push_str(&table::columns::help_text(
         &[],
         &[Col::Path, Col::X, Col::Y, Col::Z, Col::Px, Col::Py, Col::Pz, Col::Nx, Col::Ny, Col::Nz, Col::Tag],
@@ -326,7 +333,7 @@ fn run(args: Args) -> Result<()> {
     }
     let started = Instant::now();
     let input = Input::open(&args.io.input)?;
-    let model = Model::load(&input)?;
+    let model = Model::load_with(&input, args.skip_unsupported)?;
     model.check_dropped(args.strict)?;
     let loaded = started.elapsed().as_secs_f64();
     if let Some(tool) = &args.tool {

@@ -20,8 +20,8 @@ pub struct Part {
 impl Part {
     /// The part for `tool` whose body reaches `length` above its tip (the flat-type tool's wedge
     /// reaches its `flank_length` along each flank instead), with the model as a solid (B-spline
-    /// patches, bounded flipped cylinders, cones and tori as triangles within `chord` mm; see
-    /// [`Solid::of_any`]). An error names the surface the solid cannot take.
+    /// patches, trimmed STEP faces, bounded flipped cylinders, cones and tori as triangles within
+    /// `chord` mm; see [`Solid::of_any`]). An error names the surface the solid cannot take.
     pub fn new(model: Model, tool: &Tool, length: f64, chord: f64) -> Result<Part, String> {
         let body = Body::of(&Tool { length: Some(length), ..tool.clone() });
         let solid = Solid::of_any(&model, chord)?;

@@ -84,12 +84,16 @@ struct Args {
     /// Control stylus of the flat-type tool.
     #[arg(long, value_enum, default_value_t = ControlPoint::P1)]
     control: ControlPoint,
-    /// The model (JSON document or STL) for gouge checks and the flat-type correction.
+    /// The model (JSON document, STL or STEP file) for gouge checks and the flat-type correction.
     #[arg(long, value_name = "FILE")]
     model: Option<String>,
     /// Refuse a model's STL file with zero-area or repeated facets (default: left out, with a warning).
     #[arg(long)]
     strict: bool,
+    /// A STEP model's faces on surfaces or edges the reader does not take are left out, with a
+    /// warning each (default: the first is refused, naming the entity and its #id).
+    #[arg(long, requires = "model")]
+    skip_unsupported: bool,
     /// Penetration (mm) of the tool body into the model tolerated before a pose gouges.
     #[arg(long, default_value_t = 0.001, value_name = "MM")]
     gouge_tol: f64,
@@ -616,7 +620,7 @@ fn run(args: Args) -> Result<()> {
 /// 1e-6 mm, at most 2 µm).
 fn load_part(args: &Args, tool: &Tool, length: f64) -> Result<Option<Part>> {
     let Some(file) = &args.model else { return Ok(None) };
-    let model = Model::load(&Input::open(file)?)?;
+    let model = Model::load_with(&Input::open(file)?, args.skip_unsupported)?;
     // Its STL files' dropped facets warned about (or refused with --strict).
     model.check_dropped(args.strict)?;
     let chord = (0.25 * args.gouge_tol).clamp(1e-6, 0.002);

@@ -6,7 +6,7 @@
 //! origin, axis +Z, the spindle orientation's edge along +X. A [`Solid`] is a part: the material
 //! behind each surface's outward normal, from a camkit [`Model`]: meshes as triangle meshes
 //! (closed ones also answer "is this point inside"), spheres and planes as exact balls and
-//! half-spaces, B-spline patches as triangle meshes within a stated chord error.
+//! half-spaces, B-spline patches and trimmed STEP faces as triangle meshes within a stated chord error.
 //! [`Solid::of_any`] also takes every other analytic surface, for clearance queries: unbounded
 //! cylinders exactly (a rod as a cylinder long enough for the query, a bore in closed form: see
 //! [`super::closed_form`]), flipped spheres in closed form, bounded cylinders as exact cylinders
@@ -570,6 +570,11 @@ impl Solid {
                         true,
                     )?)
                 }
+                Geometry::Face(f) => {
+                    let (tris, dev) = f.triangles(chord);
+                    let turned = tris.into_iter().map(|t| if s.flip { [t[0], t[2], t[1]] } else { t });
+                    add((mesh_piece(&s.name, turned.map(|t| t.map(place)), false)?.0, dev))
+                }
                 Geometry::Analytic(a) => {
                     let what = match a {
                         Analytic::Sphere { .. } => "a sphere with its normal flipped (material outside it)",
@@ -579,7 +584,7 @@ impl Solid {
                         Analytic::Plane { .. } => unreachable!("planes are half-spaces"),
                     };
                     return Err(format!(
-                        "surface {} is {what}: the collision check takes meshes, B-spline patches, spheres and planes; give the part as an STL",
+                        "surface {} is {what}: the collision check takes meshes, B-spline patches, STEP faces, spheres and planes; give the part as an STL",
                         s.name
                     ));
                 }

@@ -265,6 +265,11 @@ impl DropCutter {
                 Geometry::Patch(_) => {
                     return Err(refuse("free-form patches are not handled by the drop-cutter: tessellate them to STL"));
                 }
+                Geometry::Face(_) => {
+                    return Err(refuse(
+                        "trimmed STEP faces are not handled by the drop-cutter: tessellate them to STL",
+                    ));
+                }
             };
             let bounds = part_bounds(&part);
             parts.push((part, bounds));

@@ -15,8 +15,11 @@ pub mod analytic;
 pub mod bvh;
 pub mod cutter;
 pub mod drop;
+pub mod face;
 pub mod mesh;
+pub mod part21;
 pub mod patch;
+pub mod step;
 
 use crate::doc::model::{ModelDoc, Placement, SurfaceDoc};
 use crate::error::{Error, Location, Result};
@@ -38,6 +41,8 @@ pub enum Geometry {
     Patch(BSpline),
     /// Triangle mesh.
     Mesh(Mesh),
+    /// A trimmed face of a CAD B-rep (a STEP file's ADVANCED_FACE).
+    Face(Box<face::Face>),
 }
 
 /// One surface of a model: its geometry as defined, a placement, and the normal's orientation.
@@ -84,6 +89,7 @@ impl Surface {
             Geometry::Analytic(a) => a.bounds(),
             Geometry::Patch(p) => p.bounds(),
             Geometry::Mesh(m) => m.bounds(),
+            Geometry::Face(f) => f.bounds(),
         };
         let bounds = match &placement {
             Some(iso) if local.is_bounded() => {
@@ -126,6 +132,7 @@ impl Surface {
             }
             Geometry::Patch(p) => p.nearest(&local_q, bound).map(|(f, _, c)| (f, c))?,
             Geometry::Mesh(m) => (m.nearest(&local_q, bound)?.foot, true),
+            Geometry::Face(f) => f.nearest(&local_q, bound)?,
         };
         let normal = if self.flip { -foot.normal } else { foot.normal };
         let foot = match &self.placement {
@@ -240,9 +247,19 @@ impl Model {
         Ok(())
     }
 
-    /// Reads a model: a model document (`.json`), or one STL file (`.stl`) as a one-surface
-    /// model. STL files named in a document are found relative to it.
+    /// Reads a model: a model document (`.json`), one STL file (`.stl`) as a one-surface
+    /// model, or a STEP file (`.step`, `.stp`) with a trimmed surface per face, refusing
+    /// unsupported STEP entities. STL files named in a document are found relative to it.
     pub fn load(input: &Input) -> Result<Model> {
+        Model::load_with(input, false)
+    }
+
+    /// [`Model::load`], leaving out (with a warning each) the STEP faces whose entities are not
+    /// supported when `skip_unsupported`.
+    pub fn load_with(input: &Input, skip_unsupported: bool) -> Result<Model> {
+        if matches!(input.extension().as_str(), "step" | "stp") {
+            return Ok(Model { surfaces: step::load(input, skip_unsupported)? });
+        }
         if input.extension() == "stl" {
             let mesh = mesh::load_stl(input)?;
             let name = Path::new(&input.name).file_stem().map_or("mesh".into(), |s| s.to_string_lossy().into_owned());

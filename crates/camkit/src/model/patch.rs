@@ -67,7 +67,7 @@ pub fn clamped_uniform(n: usize, p: usize) -> Vec<f64> {
 }
 
 /// Index of the knot span holding `t` (the last non-empty one at the domain's end).
-fn find_span(knots: &[f64], n: usize, p: usize, t: f64) -> usize {
+pub(super) fn find_span(knots: &[f64], n: usize, p: usize, t: f64) -> usize {
     if t >= knots[n] {
         let mut s = n - 1;
         while knots[s] >= knots[s + 1] {
@@ -93,7 +93,7 @@ fn find_span(knots: &[f64], n: usize, p: usize, t: f64) -> usize {
 
 /// Basis functions of degree `p` at `t` in span `s` and their first two derivatives (The NURBS
 /// Book, A2.3): `out[k][j]` is the k-th derivative of N_{s−p+j}.
-fn basis_derivs(knots: &[f64], s: usize, p: usize, t: f64) -> [[f64; MAX_DEGREE + 1]; 3] {
+pub(super) fn basis_derivs(knots: &[f64], s: usize, p: usize, t: f64) -> [[f64; MAX_DEGREE + 1]; 3] {
     const M: usize = MAX_DEGREE + 1;
     let mut ndu = [[0.0f64; M]; M];
     let mut left = [0.0f64; M];

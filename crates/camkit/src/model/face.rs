@@ -1,0 +1,850 @@
+//! Trimmed faces, what a CAD B-rep (a STEP file) is made of: a carrier surface (an analytic
+//! surface in its canonical frame, or a B-spline patch) bounded by loops of edges (lines, circle
+//! arcs, B-spline curves).
+//!
+//! The nearest point of a face is the carrier's nearest point when that lies inside the face, else
+//! the nearest point of its boundary edges (lines and arcs exact, B-spline edges by a bracketed
+//! Newton iteration to [`EDGE_TOL`]). Inside is decided in the carrier's parameter space: each
+//! loop is sampled, mapped to (u, v) (angles unwrapped across the seam of periodic surfaces) and
+//! the signed winding number of the foot's (u, v) is summed, the loops oriented as STEP orients
+//! them (the face on their left seen from the face's normal). A loop that winds once round a
+//! periodic surface (a cylinder's rim, a sphere's rim whose pole is inside) is closed through
+//! v = +∞, and the region below all such loops counts as inside when they wind the other way.
+//! Feet within [`UV_TOL`] (relative) of a loop count as inside. The loops are polygons through
+//! points [`ARC_STEP`] radians apart on arcs, so a foot nearer to a curved edge than its sagitta
+//! (R·1.9e-5: 0.5 µm on R26) may be classed on the wrong side; the distance found then differs by
+//! less than sagitta²/(2·distance).
+
+use super::analytic::{Analytic, Foot};
+use super::bvh::Aabb;
+use super::patch::{BSpline, FOOT_TOL, basis_derivs, find_span};
+use crate::geom::{P3, V3};
+use std::f64::consts::{PI, TAU};
+
+/// Largest tangential residual (mm) of a converged nearest point on a B-spline edge.
+pub const EDGE_TOL: f64 = FOOT_TOL;
+
+/// Angle (radians) between the points a loop's arcs are sampled at.
+pub const ARC_STEP: f64 = PI / 256.0;
+
+/// Distance (relative to the loops' extent in (u, v)) within which a foot is on a loop.
+pub const UV_TOL: f64 = 1e-9;
+
+/// Samples per knot span of a B-spline edge (loops and the start of its nearest-point search).
+const SPLINE_SAMPLES: usize = 32;
+
+/// The surface a face lies on, in the face's frame.
+#[derive(Clone, Debug)]
+pub enum Carrier {
+    /// Plane z = 0, cylinder, cone or torus around the z axis, or sphere, centred at the origin
+    /// (the cone's apex on the z axis); (u, v) is (x, y) on the plane, (angle about z, z) on
+    /// cylinders and cones, (longitude, latitude) on the sphere, the two angles on the torus.
+    Analytic(Analytic),
+    /// A B-spline patch and its own parameters.
+    Patch(BSpline),
+}
+
+/// A B-spline (or NURBS) curve.
+#[derive(Clone, Debug)]
+pub struct SplineCurve {
+    /// Degree, 1 to [`crate::doc::model::MAX_DEGREE`].
+    pub degree: usize,
+    /// Control points.
+    pub ctrl: Vec<P3>,
+    /// Weights (None: polynomial).
+    pub weights: Option<Vec<f64>>,
+    /// Knots, `ctrl.len() + degree + 1` of them.
+    pub knots: Vec<f64>,
+}
+
+impl SplineCurve {
+    /// Parameter domain.
+    pub fn domain(&self) -> [f64; 2] {
+        [self.knots[self.degree], self.knots[self.ctrl.len()]]
+    }
+
+    /// Point, first and second derivative at `t`.
+    pub fn eval(&self, t: f64) -> (P3, V3, V3) {
+        let (p, n) = (self.degree, self.ctrl.len());
+        let s = find_span(&self.knots, n, p, t);
+        let b = basis_derivs(&self.knots, s, p, t);
+        let (mut a, mut w) = ([V3::zeros(); 3], [0.0; 3]);
+        for k in s - p..=s {
+            let wk = self.weights.as_ref().map_or(1.0, |ws| ws[k]);
+            for ((ad, wd), bd) in a.iter_mut().zip(w.iter_mut()).zip(&b) {
+                let basis = wk * bd[k + p - s];
+                *ad += self.ctrl[k].coords * basis;
+                *wd += basis;
+            }
+        }
+        let c = a[0] / w[0];
+        let c1 = (a[1] - c * w[1]) / w[0];
+        let c2 = (a[2] - c1 * (2.0 * w[1]) - c * w[2]) / w[0];
+        (P3::from(c), c1, c2)
+    }
+
+    /// Number of non-empty knot spans in [t0, t1].
+    fn spans(&self, t0: f64, t1: f64) -> usize {
+        let k = &self.knots[self.degree..=self.ctrl.len()];
+        k.windows(2).filter(|w| w[1] > w[0] && w[1] > t0 && w[0] < t1).count().max(1)
+    }
+
+    /// The parameter in [t0, t1] of the nearest point to `q`, and whether it converged.
+    pub fn nearest(&self, q: &P3, t0: f64, t1: f64) -> (f64, bool) {
+        let m = SPLINE_SAMPLES * self.spans(t0, t1);
+        let ts: Vec<f64> = (0..=m).map(|i| t0 + (t1 - t0) * i as f64 / m as f64).collect();
+        let d2 = |t: f64| (self.eval(t).0 - q).norm_squared();
+        let i = (0..=m).min_by(|&a, &b| d2(ts[a]).total_cmp(&d2(ts[b]))).expect("samples");
+        // g(t) = (C − q)·C' is the derivative of |C − q|²/2; its sign says which way is down.
+        let g = |t: f64| {
+            let (c, c1, c2) = self.eval(t);
+            let r = c - q;
+            (r.dot(&c1), c1.dot(&c1) + r.dot(&c2), c1.norm())
+        };
+        let (gi, _, _) = g(ts[i]);
+        if gi == 0.0 {
+            return (ts[i], true);
+        }
+        let (mut lo, mut hi) = if gi > 0.0 {
+            if i == 0 {
+                return (ts[0], true);
+            }
+            (ts[i - 1], ts[i])
+        } else {
+            if i == m {
+                return (ts[m], true);
+            }
+            (ts[i], ts[i + 1])
+        };
+        if (g(lo).0 > 0.0) || (g(hi).0 < 0.0) {
+            // No sign change: the sampled minimum is the best there is.
+            return (ts[i], false);
+        }
+        let mut t = ts[i];
+        for _ in 0..200 {
+            let (gt, gp, st) = g(t);
+            if gt == 0.0 {
+                return (t, true);
+            }
+            if gt < 0.0 {
+                lo = t
+            } else {
+                hi = t
+            }
+            let newton = t - gt / gp;
+            let next = if gp > 0.0 && newton > lo && newton < hi { newton } else { 0.5 * (lo + hi) };
+            // Newton's steps shrink quadratically: one below a thousandth of the tolerance ends it.
+            if (next - t).abs() * st <= 1e-3 * EDGE_TOL || hi - lo <= f64::EPSILON * (lo.abs() + hi.abs()) {
+                let (gn, _, sn) = g(next);
+                return (next, gn.abs() <= EDGE_TOL * sn);
+            }
+            t = next;
+        }
+        (t, false)
+    }
+}
+
+/// A boundary curve of a face, in the face's frame, over its own parameter order.
+#[derive(Clone, Debug)]
+pub enum Curve {
+    /// Segment from `a` to `b`.
+    Line {
+        /// Start.
+        a: P3,
+        /// End.
+        b: P3,
+    },
+    /// Arc of the circle `centre + radius (x cos t + y sin t)` for t in [t0, t1] (t1 > t0).
+    Arc {
+        /// Centre.
+        centre: P3,
+        /// Unit direction of t = 0.
+        x: V3,
+        /// Unit direction of t = π/2.
+        y: V3,
+        /// Radius.
+        radius: f64,
+        /// Start angle.
+        t0: f64,
+        /// End angle.
+        t1: f64,
+    },
+    /// A B-spline curve over [t0, t1].
+    Spline {
+        /// The curve.
+        curve: SplineCurve,
+        /// Start parameter.
+        t0: f64,
+        /// End parameter.
+        t1: f64,
+    },
+}
+
+impl Curve {
+    /// The exact (lines, arcs) or converged nearest point to `q`.
+    pub fn nearest(&self, q: &P3) -> (P3, bool) {
+        match self {
+            Curve::Line { a, b } => {
+                let d = b - a;
+                let t = ((q - a).dot(&d) / d.norm_squared()).clamp(0.0, 1.0);
+                (a + d * t, true)
+            }
+            Curve::Arc { centre, x, y, radius, t0, t1 } => {
+                let d = q - centre;
+                let (cx, cy) = (d.dot(x), d.dot(y));
+                let at = |t: f64| centre + (x * t.cos() + y * t.sin()) * *radius;
+                if cx.hypot(cy) > crate::tol::LENGTH_EPS {
+                    let t = t0 + (cy.atan2(cx) - t0).rem_euclid(TAU);
+                    if t <= *t1 {
+                        return (at(t), true);
+                    }
+                }
+                let (a, b) = (at(*t0), at(*t1));
+                (if (a - q).norm_squared() <= (b - q).norm_squared() { a } else { b }, true)
+            }
+            Curve::Spline { curve, t0, t1 } => {
+                let (t, converged) = curve.nearest(q, *t0, *t1);
+                (curve.eval(t).0, converged)
+            }
+        }
+    }
+
+    /// Points along the curve from its start to its end (both included), dense enough for a loop.
+    fn samples(&self, straight: bool) -> Vec<P3> {
+        match self {
+            Curve::Line { a, b } => {
+                let n = if straight { 1 } else { 16 };
+                (0..=n).map(|i| a + (b - a) * (i as f64 / n as f64)).collect()
+            }
+            Curve::Arc { centre, x, y, radius, t0, t1 } => {
+                let n = ((t1 - t0) / ARC_STEP).ceil().max(1.0) as usize;
+                (0..=n)
+                    .map(|i| {
+                        let t = t0 + (t1 - t0) * i as f64 / n as f64;
+                        centre + (x * t.cos() + y * t.sin()) * *radius
+                    })
+                    .collect()
+            }
+            Curve::Spline { curve, t0, t1 } => {
+                let n = SPLINE_SAMPLES * curve.spans(*t0, *t1);
+                (0..=n).map(|i| curve.eval(t0 + (t1 - t0) * i as f64 / n as f64).0).collect()
+            }
+        }
+    }
+
+    /// A box holding the curve.
+    pub fn bounds(&self) -> Aabb {
+        match self {
+            Curve::Line { a, b } => Aabb::of(&[*a, *b]),
+            Curve::Arc { centre, x, y, radius, .. } => {
+                let n = x.cross(y);
+                let ext = V3::from_fn(|i, _| radius * (1.0 - n[i] * n[i]).max(0.0).sqrt());
+                Aabb { min: centre - ext, max: centre + ext }
+            }
+            Curve::Spline { curve, .. } => Aabb::of(&curve.ctrl),
+        }
+    }
+}
+
+/// One loop in (u, v): its segments (the closing one too unless the loop winds round a periodic
+/// u), how many times it winds, its lowest u and v, the segments by column of u (the only ones
+/// a ray from a point towards +v can cross: its winding number) and by cell of a grid (the only
+/// ones near a point).
+#[derive(Clone, Debug)]
+struct Loop {
+    segs: Vec<([f64; 2], [f64; 2])>,
+    wraps: i32,
+    min: [f64; 2],
+    /// First and last point (a winding loop is closed through v = +∞ from the last to the first).
+    ends: [[f64; 2]; 2],
+    /// Lowest corner of the grid and the size of a cell.
+    origin: [f64; 2],
+    cell: [f64; 2],
+    columns: Vec<Vec<u32>>,
+    cells: Vec<Vec<u32>>,
+}
+
+/// Columns of u, and cells each way, per loop.
+const GRID: usize = 64;
+
+impl Loop {
+    fn new(uv: Vec<[f64; 2]>, wraps: i32, tol: f64) -> Loop {
+        let n = uv.len();
+        let count = if wraps == 0 { n } else { n - 1 };
+        let segs: Vec<_> = (0..count).map(|k| (uv[k], uv[(k + 1) % n])).collect();
+        let lo = |c: usize| uv.iter().map(|p| p[c]).fold(f64::INFINITY, f64::min);
+        let hi = |c: usize| uv.iter().map(|p| p[c]).fold(f64::NEG_INFINITY, f64::max);
+        let min = [lo(0), lo(1)];
+        let origin = [min[0] - tol, min[1] - tol];
+        let cell = [0, 1].map(|c| ((hi(c) - min[c] + 2.0 * tol) / GRID as f64).max(f64::MIN_POSITIVE));
+        let index = |c: usize, x: f64| (((x - origin[c]) / cell[c]).floor().max(0.0) as usize).min(GRID - 1);
+        let mut columns = vec![Vec::new(); GRID];
+        let mut cells = vec![Vec::new(); GRID * GRID];
+        for (k, (a, b)) in segs.iter().enumerate() {
+            let (u0, u1) = (index(0, a[0].min(b[0]) - tol), index(0, a[0].max(b[0]) + tol));
+            let (v0, v1) = (index(1, a[1].min(b[1]) - tol), index(1, a[1].max(b[1]) + tol));
+            for i in u0..=u1 {
+                columns[i].push(k as u32);
+                for j in v0..=v1 {
+                    cells[j * GRID + i].push(k as u32);
+                }
+            }
+        }
+        Loop { segs, wraps, min, ends: [uv[0], uv[n - 1]], origin, cell, columns, cells }
+    }
+
+    /// Index of `x` along coordinate `c` of the grid, if inside it.
+    fn slot(&self, c: usize, x: f64) -> Option<usize> {
+        let k = ((x - self.origin[c]) / self.cell[c]).floor();
+        (k >= 0.0 && k < GRID as f64).then_some(k as usize)
+    }
+
+    /// The segments whose column of u holds `u` (none outside the loop's range).
+    fn column(&self, u: f64) -> impl Iterator<Item = &([f64; 2], [f64; 2])> {
+        let list = self.slot(0, u).map_or(&[][..], |k| self.columns[k].as_slice());
+        list.iter().map(|&i| &self.segs[i as usize])
+    }
+
+    /// True when `q` is within `tol` of the loop.
+    fn touches(&self, q: [f64; 2], tol: f64) -> bool {
+        let (Some(i), Some(j)) = (self.slot(0, q[0]), self.slot(1, q[1])) else { return false };
+        self.cells[j * GRID + i].iter().any(|&k| {
+            let (a, b) = self.segs[k as usize];
+            segment_distance(q, a, b) <= tol
+        })
+    }
+
+    /// Signed winding number about `p` (a winding loop closed through v = +∞), counted on the
+    /// ray from `p` towards +v: in coordinates turned a quarter (u, v) → (v, −u), where that ray
+    /// runs towards +u, by Sunday's crossing rule.
+    fn winding(&self, p: [f64; 2]) -> i32 {
+        let turn = |q: [f64; 2]| [q[1], -q[0]];
+        let [first, last] = self.ends;
+        let mut p = p;
+        if self.wraps > 0 {
+            // The rule counts a vertex of the ray's line at a segment's end for segments running
+            // towards +u, at its start for those running towards −u: the loop's first point is
+            // taken as its last.
+            p[0] = first[0] + TAU - (first[0] + TAU - p[0]).rem_euclid(TAU);
+        } else if self.wraps < 0 {
+            p[0] = first[0] - (first[0] - p[0]).rem_euclid(TAU);
+        }
+        let mut w = 0;
+        for (a, b) in self.column(p[0]) {
+            w += crossing(turn(*a), turn(*b), turn(p));
+        }
+        if self.wraps != 0 {
+            // Closed through a top above everything, from the last point up, across and down to
+            // the first: the ray crosses the top once, whatever its u.
+            let top = self.origin[1] + self.cell[1] * GRID as f64 + p[1].abs() + 1.0;
+            let mid = [0.5 * (first[0] + last[0]), p[1]];
+            w += crossing(turn([last[0], top]), turn([first[0], top]), turn(mid));
+        }
+        w
+    }
+}
+
+/// The winding number's count for segment a → b about `p` (Sunday's crossing rule).
+fn crossing(a: [f64; 2], b: [f64; 2], p: [f64; 2]) -> i32 {
+    if (a[1] <= p[1]) == (b[1] <= p[1]) {
+        return 0;
+    }
+    let left = (b[0] - a[0]) * (p[1] - a[1]) - (p[0] - a[0]) * (b[1] - a[1]);
+    if a[1] <= p[1] { i32::from(b[1] > p[1] && left > 0.0) } else { -i32::from(b[1] <= p[1] && left < 0.0) }
+}
+
+/// A trimmed face: carrier, boundary loops and the sense of its normal.
+#[derive(Clone, Debug)]
+pub struct Face {
+    carrier: Carrier,
+    edges: Vec<(Curve, Aabb)>,
+    loops: Vec<Loop>,
+    /// +1 when the face's normal is the carrier's, −1 when reversed (the loops turn the other
+    /// way in (u, v)).
+    sense: f64,
+    /// Distance in (u, v) within which a foot is on a loop.
+    tol: f64,
+    bounds: Aabb,
+}
+
+impl Carrier {
+    /// Which of (u, v) are angles.
+    fn periodic(&self) -> [bool; 2] {
+        match self {
+            Carrier::Analytic(Analytic::Plane { .. }) | Carrier::Patch(_) => [false, false],
+            Carrier::Analytic(Analytic::Torus { .. }) => [true, true],
+            Carrier::Analytic(_) => [true, false],
+        }
+    }
+
+    /// (u, v) of a point on the carrier; u is None on the axis of a surface of revolution.
+    fn param(&self, p: &P3) -> (Option<f64>, f64) {
+        let rho = p.x.hypot(p.y);
+        let u = (rho > 1e-12 * (1.0 + p.coords.norm())).then(|| p.y.atan2(p.x));
+        match self {
+            Carrier::Analytic(Analytic::Plane { .. }) => (Some(p.x), p.y),
+            Carrier::Analytic(Analytic::Sphere { .. }) => (u, p.z.atan2(rho)),
+            Carrier::Analytic(Analytic::Torus { major, .. }) => (u, p.z.atan2(rho - major)),
+            Carrier::Analytic(_) => (u, p.z),
+            Carrier::Patch(s) => {
+                let (_, uv, _) = s.nearest(p, f64::INFINITY).expect("an unbounded query finds a point");
+                (Some(uv[0]), uv[1])
+            }
+        }
+    }
+
+    /// The nearest point no farther than `bound`: foot, its (u, v) and whether it converged.
+    fn foot(&self, q: &P3, bound: f64) -> Option<(Foot, [f64; 2], bool)> {
+        match self {
+            Carrier::Analytic(a) => {
+                let f = a.foot(q);
+                if (f.point - q).norm() > bound {
+                    return None;
+                }
+                let (u, v) = self.param(&f.point);
+                Some((f, [u.unwrap_or(0.0), v], true))
+            }
+            Carrier::Patch(s) => s.nearest(q, bound),
+        }
+    }
+
+    /// The point at (u, v).
+    fn point(&self, [u, v]: [f64; 2]) -> P3 {
+        match self {
+            Carrier::Analytic(Analytic::Plane { .. }) => P3::new(u, v, 0.0),
+            Carrier::Analytic(Analytic::Cylinder { radius, .. }) => P3::new(radius * u.cos(), radius * u.sin(), v),
+            Carrier::Analytic(Analytic::Cone { apex, half_angle, .. }) => {
+                let rho = (v - apex.z) * half_angle.tan();
+                P3::new(rho * u.cos(), rho * u.sin(), v)
+            }
+            Carrier::Analytic(Analytic::Sphere { radius, .. }) => {
+                P3::new(radius * v.cos() * u.cos(), radius * v.cos() * u.sin(), radius * v.sin())
+            }
+            Carrier::Analytic(Analytic::Torus { major, minor, .. }) => {
+                let rho = major + minor * v.cos();
+                P3::new(rho * u.cos(), rho * u.sin(), minor * v.sin())
+            }
+            Carrier::Patch(s) => s.eval(u, v).s,
+        }
+    }
+
+    /// The carrier's normal at a point on it.
+    fn normal_at(&self, p: &P3) -> V3 {
+        match self {
+            Carrier::Analytic(a) => a.foot(p).normal,
+            Carrier::Patch(s) => s.nearest(p, f64::INFINITY).expect("an unbounded query finds a point").0.normal,
+        }
+    }
+}
+
+/// Distance from `p` to the segment from `a` to `b`.
+fn segment_distance(p: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
+    let d = [b[0] - a[0], b[1] - a[1]];
+    let len2 = d[0] * d[0] + d[1] * d[1];
+    let t = if len2 > 0.0 { (((p[0] - a[0]) * d[0] + (p[1] - a[1]) * d[1]) / len2).clamp(0.0, 1.0) } else { 0.0 };
+    (p[0] - a[0] - t * d[0]).hypot(p[1] - a[1] - t * d[1])
+}
+
+impl Face {
+    /// A face on `carrier` bounded by `loops`, each a list of curves with the direction they are
+    /// walked in (true: from the curve's start to its end), oriented as STEP orients them for a
+    /// face whose normal is the carrier's when `same_sense`.
+    pub fn new(carrier: Carrier, loops: Vec<Vec<(Curve, bool)>>, same_sense: bool) -> Face {
+        let periodic = carrier.periodic();
+        let straight = matches!(carrier, Carrier::Analytic(Analytic::Plane { .. } | Analytic::Cylinder { .. }));
+        let mut polys = Vec::new();
+        let mut edges = Vec::new();
+        let mut extent = Aabb::empty();
+        for lp in loops {
+            let mut pts: Vec<(Option<f64>, f64)> = Vec::new();
+            for (curve, forward) in lp {
+                let mut s = curve.samples(straight);
+                if !forward {
+                    s.reverse();
+                }
+                s.pop();
+                pts.extend(s.iter().map(|p| carrier.param(p)));
+                let b = curve.bounds();
+                extent = extent.union(&b);
+                edges.push((curve, b));
+            }
+            if pts.is_empty() {
+                continue;
+            }
+            // A point on the axis takes the angle of its neighbour along the loop.
+            if let Some(k) = pts.iter().position(|p| p.0.is_some()) {
+                let n = pts.len();
+                for i in 1..n {
+                    let (j, prev) = ((k + i) % n, (k + i - 1) % n);
+                    if pts[j].0.is_none() {
+                        pts[j].0 = pts[prev].0;
+                    }
+                }
+            }
+            let mut uv: Vec<[f64; 2]> = pts.iter().map(|p| [p.0.unwrap_or(0.0), p.1]).collect();
+            for i in 1..uv.len() {
+                for c in 0..2 {
+                    if periodic[c] {
+                        let prev = uv[i - 1][c];
+                        uv[i][c] = prev + (uv[i][c] - prev + PI).rem_euclid(TAU) - PI;
+                    }
+                }
+            }
+            // Closing the loop: how far it has wound round u.
+            let last = uv[uv.len() - 1];
+            let wraps = if periodic[0] {
+                let closed = last[0] + (uv[0][0] - last[0] + PI).rem_euclid(TAU) - PI;
+                ((closed - uv[0][0]) / TAU).round() as i32
+            } else {
+                0
+            };
+            polys.push((uv, wraps));
+        }
+        let span = polys.iter().flat_map(|(uv, _)| uv.iter()).fold(0.0f64, |m, p| m.max(p[0].abs()).max(p[1].abs()));
+        let tol = UV_TOL * (1.0 + span);
+        let polys = polys.into_iter().map(|(uv, wraps)| Loop::new(uv, wraps, tol)).collect();
+        let bounds = match &carrier {
+            Carrier::Analytic(Analytic::Plane { .. }) => extent,
+            Carrier::Analytic(a) => a.bounds(),
+            Carrier::Patch(s) => s.bounds(),
+        };
+        Face { carrier, edges, loops: polys, sense: if same_sense { 1.0 } else { -1.0 }, tol, bounds }
+    }
+
+    /// A box holding the face (its carrier's when curved, its boundary's when planar).
+    pub fn bounds(&self) -> Aabb {
+        self.bounds
+    }
+
+    /// The carrier.
+    pub fn carrier(&self) -> &Carrier {
+        &self.carrier
+    }
+
+    /// True when `p`, a point of the carrier (face frame), is inside the face or on its boundary.
+    pub fn contains(&self, p: &P3) -> bool {
+        let (u, v) = self.carrier.param(p);
+        self.inside([u.unwrap_or(0.0), v])
+    }
+
+    /// The boundary curves of every loop.
+    pub fn edges(&self) -> impl Iterator<Item = &Curve> {
+        self.edges.iter().map(|(c, _)| c)
+    }
+
+    /// True when (u, v) is inside the face or on its boundary.
+    pub fn inside(&self, uv: [f64; 2]) -> bool {
+        let periodic = self.carrier.periodic();
+        let shifts = |c: usize| if periodic[c] { &[0.0, -TAU, TAU][..] } else { &[0.0][..] };
+        let (mut w, mut wraps) = (0i32, 0i32);
+        for l in &self.loops {
+            let mut p = uv;
+            for c in 0..2 {
+                if periodic[c] {
+                    p[c] = l.min[c] + (p[c] - l.min[c]).rem_euclid(TAU);
+                }
+            }
+            for du in shifts(0) {
+                for dv in shifts(1) {
+                    let q = [p[0] + du, p[1] + dv];
+                    if l.touches(q, self.tol) {
+                        return true;
+                    }
+                }
+            }
+            w += l.winding(p);
+            wraps += l.wraps;
+        }
+        let below = (-(self.sense as i32) * wraps).max(0);
+        self.sense as i32 * w + below >= 1
+    }
+
+    /// Triangles covering the face (face frame, turned so that their right-hand normals follow
+    /// the carrier's) and the largest distance found between them and the surface: a constrained
+    /// Delaunay triangulation (`spade`) in (u, v) of the loops (as constraints) and a grid of
+    /// points, the grid halved until that distance is below `chord` (at most 512 × 512); the
+    /// triangles whose middle is inside the face are kept. The boundary is the loops' polygon.
+    pub fn triangles(&self, chord: f64) -> (Vec<[P3; 3]>, f64) {
+        use spade::{ConstrainedDelaunayTriangulation, Point2, Triangulation};
+        let periodic = self.carrier.periodic();
+        let pts = || self.loops.iter().flat_map(|l| l.segs.iter().flat_map(|(a, b)| [*a, *b]));
+        let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+        for p in pts() {
+            for c in 0..2 {
+                lo[c] = lo[c].min(p[c]);
+                hi[c] = hi[c].max(p[c]);
+            }
+        }
+        if self.loops.iter().any(|l| l.wraps != 0) {
+            hi[0] = hi[0].max(lo[0] + TAU);
+            if let Carrier::Analytic(Analytic::Sphere { .. }) = self.carrier {
+                // Out to the pole the face holds.
+                if self.inside([lo[0], -PI / 2.0]) {
+                    lo[1] = -PI / 2.0;
+                }
+                if self.inside([lo[0], PI / 2.0]) {
+                    hi[1] = PI / 2.0;
+                }
+            }
+        }
+        if periodic[1] && (hi[1] - lo[1]) > TAU {
+            hi[1] = lo[1] + TAU;
+        }
+        let mut n = 16usize;
+        loop {
+            let mut cdt = ConstrainedDelaunayTriangulation::<Point2<f64>>::new();
+            let mut put = |p: [f64; 2]| cdt.insert(Point2::new(p[0], p[1])).ok();
+            for i in 0..=n {
+                for j in 0..=n {
+                    let f = [i as f64 / n as f64, j as f64 / n as f64];
+                    put([lo[0] + (hi[0] - lo[0]) * f[0], lo[1] + (hi[1] - lo[1]) * f[1]]);
+                }
+            }
+            let mut constraints = Vec::new();
+            for l in &self.loops {
+                for (a, b) in &l.segs {
+                    if let (Some(a), Some(b)) = (put(*a), put(*b)) {
+                        constraints.push((a, b));
+                    }
+                }
+            }
+            for (a, b) in constraints {
+                if a != b {
+                    cdt.try_add_constraint(a, b);
+                }
+            }
+            let mut tris = Vec::new();
+            let mut worst = 0.0f64;
+            for f in cdt.inner_faces() {
+                let uv = f.vertices().map(|v| [v.position().x, v.position().y]);
+                let mid = [(uv[0][0] + uv[1][0] + uv[2][0]) / 3.0, (uv[0][1] + uv[1][1] + uv[2][1]) / 3.0];
+                if !self.inside(mid) {
+                    continue;
+                }
+                let t = uv.map(|q| self.carrier.point(q));
+                let nrm = (t[1] - t[0]).cross(&(t[2] - t[0]));
+                let len = nrm.norm();
+                if len <= 1e-12 {
+                    continue; // collapsed at a pole or an apex
+                }
+                for k in 0..3 {
+                    let e = [(uv[k][0] + uv[(k + 1) % 3][0]) / 2.0, (uv[k][1] + uv[(k + 1) % 3][1]) / 2.0];
+                    for q in [e, mid] {
+                        worst = worst.max(((self.carrier.point(q) - t[0]).dot(&nrm) / len).abs());
+                    }
+                }
+                tris.push(t);
+            }
+            if worst <= chord || n >= 512 {
+                return (tris, worst);
+            }
+            n *= 2;
+        }
+    }
+
+    /// The nearest point of the face to `q` no farther than `bound`, the carrier's normal there
+    /// and whether the iterations converged.
+    pub fn nearest(&self, q: &P3, bound: f64) -> Option<(Foot, bool)> {
+        let (foot, uv, converged) = self.carrier.foot(q, bound)?;
+        if self.inside(uv) {
+            return Some((foot, converged));
+        }
+        let mut best: Option<(P3, bool, f64)> = None;
+        let mut limit = bound;
+        for (curve, b) in &self.edges {
+            if b.dist2(q).sqrt() > limit {
+                continue;
+            }
+            let (p, c) = curve.nearest(q);
+            let d = (p - q).norm();
+            if d <= limit && best.is_none_or(|(_, _, bd)| d < bd) {
+                limit = d;
+                best = Some((p, c, d));
+            }
+        }
+        let (p, c, _) = best?;
+        Some((Foot { point: p, normal: self.carrier.normal_at(&p) }, c))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn circle(centre: P3, radius: f64) -> Curve {
+        Curve::Arc { centre, x: V3::x(), y: V3::y(), radius, t0: 0.0, t1: TAU }
+    }
+
+    fn square(a: f64) -> Vec<(Curve, bool)> {
+        let c = [P3::new(-a, -a, 0.0), P3::new(a, -a, 0.0), P3::new(a, a, 0.0), P3::new(-a, a, 0.0)];
+        (0..4).map(|k| (Curve::Line { a: c[k], b: c[(k + 1) % 4] }, true)).collect()
+    }
+
+    /// A 100 × 100 plane with a hole of radius 10 at the origin: over the hole the nearest point
+    /// is on the rim, at the closed-form distance.
+    #[test]
+    fn plane_with_a_hole_gives_the_rim_over_the_hole() {
+        let plane = Carrier::Analytic(Analytic::Plane { point: P3::origin(), normal: V3::z() });
+        let face = Face::new(plane, vec![square(50.0), vec![(circle(P3::origin(), 10.0), false)]], true);
+        for (x, y, z) in [(3.0, 4.0, 2.0), (0.0, 0.0, 5.0), (-7.0, 1.0, -3.0), (9.9, 0.0, 1.0)] {
+            let q = P3::new(x, y, z);
+            let (f, ok) = face.nearest(&q, f64::INFINITY).unwrap();
+            let rho: f64 = x.hypot(y);
+            let want = (10.0 - rho).hypot(z);
+            assert!(ok && ((f.point - q).norm() - want).abs() < 1e-12, "{q}: {} vs {want}", (f.point - q).norm());
+            assert!((f.point.coords.xy().norm() - 10.0).abs() < 1e-12 && f.normal == V3::z());
+        }
+        // On the solid part: the foot on the plane; beyond the outer edge: the edge.
+        let (f, _) = face.nearest(&P3::new(20.0, -30.0, 4.0), f64::INFINITY).unwrap();
+        assert_eq!(f.point, P3::new(20.0, -30.0, 0.0));
+        let (f, _) = face.nearest(&P3::new(60.0, 10.0, 4.0), f64::INFINITY).unwrap();
+        assert!((f.point - P3::new(50.0, 10.0, 0.0)).norm() < 1e-12);
+        assert!(face.nearest(&P3::new(60.0, 10.0, 4.0), 10.0).is_none());
+        // The same face with its normal reversed (loops turn the other way): the same answers.
+        let plane = Carrier::Analytic(Analytic::Plane { point: P3::origin(), normal: V3::z() });
+        let rev = |l: Vec<(Curve, bool)>| l.into_iter().rev().map(|(c, f)| (c, !f)).collect::<Vec<_>>();
+        let back = Face::new(plane, vec![rev(square(50.0)), rev(vec![(circle(P3::origin(), 10.0), false)])], false);
+        for uv in [[3.0, 4.0], [20.0, -30.0], [60.0, 0.0], [0.0, 0.0]] {
+            assert_eq!(back.inside(uv), face.inside(uv), "{uv:?}");
+        }
+    }
+
+    /// A spherical dish (R40 centred 30 above its rim plane, the cap below the rim, normal
+    /// reversed) bounded by its rim and a seam down to the pole, as a CAD system writes it: points
+    /// over the dish get the sphere's foot, points beside it the rim.
+    #[test]
+    fn sphere_dish_is_bounded_by_its_rim() {
+        let (r, h) = (40.0f64, 30.0f64);
+        let rim_r = (r * r - h * h).sqrt();
+        let sphere = Carrier::Analytic(Analytic::Sphere { centre: P3::origin(), radius: r });
+        let rim = circle(P3::new(0.0, 0.0, -h), rim_r);
+        let seam =
+            Curve::Arc { centre: P3::origin(), x: V3::x(), y: -V3::z(), radius: r, t0: (h / r).asin(), t1: PI / 2.0 };
+        let face = Face::new(sphere, vec![vec![(rim, true), (seam.clone(), true), (seam, false)]], false);
+        for (x, y, z) in [(0.0, 0.0, 0.0), (5.0, -3.0, -10.0), (10.0, 10.0, -35.0), (0.0, 0.0, -45.0)] {
+            let q = P3::new(x, y, z);
+            let (f, _) = face.nearest(&q, f64::INFINITY).unwrap();
+            assert!(((f.point - q).norm() - (r - q.coords.norm()).abs()).abs() < 1e-12, "{q}");
+        }
+        let q = P3::new(40.0, 0.0, -25.0);
+        let (f, _) = face.nearest(&q, f64::INFINITY).unwrap();
+        assert!((f.point - P3::new(rim_r, 0.0, -h)).norm() < 1e-12, "{}", f.point);
+    }
+
+    /// A quarter-round fillet: the cylinder x² + y² = 25 for x, y ≥ 0, 0 ≤ z ≤ 50, and the
+    /// matching quarter of a torus (major 20, minor 5) round the z axis.
+    #[test]
+    fn cylinder_and_torus_fillets_against_closed_forms() {
+        let cyl = Carrier::Analytic(Analytic::Cylinder {
+            point: P3::origin(),
+            axis: V3::z(),
+            radius: 5.0,
+            from: 0.0,
+            to: 50.0,
+        });
+        let arc = |z: f64, t0: f64, t1: f64| Curve::Arc {
+            centre: P3::new(0.0, 0.0, z),
+            x: V3::x(),
+            y: V3::y(),
+            radius: 5.0,
+            t0,
+            t1,
+        };
+        let (a, b) = (P3::new(5.0, 0.0, 0.0), P3::new(0.0, 5.0, 0.0));
+        let l = vec![
+            (arc(0.0, 0.0, PI / 2.0), true),
+            (Curve::Line { a: b, b: b + V3::z() * 50.0 }, true),
+            (arc(50.0, 0.0, PI / 2.0), false),
+            (Curve::Line { a, b: a + V3::z() * 50.0 }, false),
+        ];
+        let face = Face::new(cyl, vec![l], true);
+        for (x, y, z) in [(8.0, 6.0, 20.0), (1.0, 1.0, 3.0), (4.0, 30.0, 49.0)] {
+            let q = P3::new(x, y, z);
+            let (f, _) = face.nearest(&q, f64::INFINITY).unwrap();
+            assert!(((f.point - q).norm() - (x.hypot(y) - 5.0).abs()).abs() < 1e-12, "{q}");
+        }
+        // Outside the quarter: the nearest straight edge.
+        let q = P3::new(-3.0, 8.0, 10.0);
+        let (f, _) = face.nearest(&q, f64::INFINITY).unwrap();
+        assert!((f.point - P3::new(0.0, 5.0, 10.0)).norm() < 1e-12, "{}", f.point);
+
+        let torus = Carrier::Analytic(Analytic::Torus { centre: P3::origin(), axis: V3::z(), major: 20.0, minor: 5.0 });
+        let ring = |z: f64, r: f64| Curve::Arc {
+            centre: P3::new(0.0, 0.0, z),
+            x: V3::x(),
+            y: V3::y(),
+            radius: r,
+            t0: 0.0,
+            t1: TAU,
+        };
+        let seam =
+            Curve::Arc { centre: P3::new(20.0, 0.0, 0.0), x: V3::x(), y: V3::z(), radius: 5.0, t0: 0.0, t1: PI / 2.0 };
+        // The outer upper quarter of the tube: from the equator (ρ = 25) up to the top (z = 5).
+        let l = vec![(ring(0.0, 25.0), true), (seam.clone(), true), (ring(5.0, 20.0), false), (seam, false)];
+        let face = Face::new(torus, vec![l], true);
+        for (x, y, z) in [(30.0, 4.0, 3.0), (-15.0, 18.0, 7.0), (0.0, -28.0, 0.5)] {
+            let q = P3::new(x, y, z);
+            let (f, _) = face.nearest(&q, f64::INFINITY).unwrap();
+            let want = (x.hypot(y) - 20.0).hypot(z) - 5.0;
+            assert!(((f.point - q).norm() - want).abs() < 1e-12, "{q}");
+        }
+        // Below the equator the rim circle ρ = 25, z = 0 is nearest.
+        let q = P3::new(0.0, 30.0, -4.0);
+        let (f, _) = face.nearest(&q, f64::INFINITY).unwrap();
+        assert!((f.point - P3::new(0.0, 25.0, 0.0)).norm() < 1e-12, "{}", f.point);
+    }
+
+    /// The triangles of a plane with a hole cover its area less the hole's (the hole's polygon),
+    /// face up; those of the dish lie on the sphere below the rim, within the chord.
+    #[test]
+    fn triangles_cover_the_face() {
+        let plane = Carrier::Analytic(Analytic::Plane { point: P3::origin(), normal: V3::z() });
+        let face = Face::new(plane, vec![square(50.0), vec![(circle(P3::origin(), 10.0), false)]], true);
+        let (tris, dev) = face.triangles(1e-6);
+        let area: f64 = tris.iter().map(|t| 0.5 * (t[1] - t[0]).cross(&(t[2] - t[0])).z).sum();
+        let n = (TAU / ARC_STEP).round();
+        let hole = 0.5 * n * 100.0 * (TAU / n).sin();
+        assert!((area - (1e4 - hole)).abs() < 1e-6 && dev < 1e-9, "{area} vs {}", 1e4 - hole);
+        assert!(tris.iter().all(|t| (t[0] + t[1].coords + t[2].coords).coords.xy().norm() / 3.0 > 9.9));
+        let (r, h) = (40.0f64, 30.0f64);
+        let sphere = Carrier::Analytic(Analytic::Sphere { centre: P3::origin(), radius: r });
+        let rim = circle(P3::new(0.0, 0.0, -h), (r * r - h * h).sqrt());
+        let seam =
+            Curve::Arc { centre: P3::origin(), x: V3::x(), y: -V3::z(), radius: r, t0: (h / r).asin(), t1: PI / 2.0 };
+        let dish = Face::new(sphere, vec![vec![(rim, true), (seam.clone(), true), (seam, false)]], false);
+        let (tris, dev) = dish.triangles(1e-3);
+        assert!(dev <= 1e-3 && tris.len() > 100, "{dev}");
+        for t in &tris {
+            for p in t {
+                assert!((p.coords.norm() - r).abs() < 1e-9 && p.z <= -h + 1e-9, "{p}");
+            }
+            // Turned with the carrier's normal (outward from the centre).
+            let c = (t[0].coords + t[1].coords + t[2].coords) / 3.0;
+            assert!((t[1] - t[0]).cross(&(t[2] - t[0])).dot(&c) > 0.0);
+        }
+        // Together they cover the cap: 2πR(R − h) less the chord's shortfall.
+        let area: f64 = tris.iter().map(|t| 0.5 * (t[1] - t[0]).cross(&(t[2] - t[0])).norm()).sum();
+        let cap = TAU * r * (r - h);
+        assert!(area < cap && area > cap * 0.999, "{area} vs {cap}");
+    }
+
+    #[test]
+    fn spline_edge_nearest_converges() {
+        // A quarter circle as a rational quadratic: the nearest point is radial.
+        let h = std::f64::consts::FRAC_1_SQRT_2;
+        let curve = SplineCurve {
+            degree: 2,
+            ctrl: vec![P3::new(10.0, 0.0, 0.0), P3::new(10.0, 10.0, 0.0), P3::new(0.0, 10.0, 0.0)],
+            weights: Some(vec![1.0, h, 1.0]),
+            knots: vec![0.0, 0.0, 0.0, 1.0, 1.0, 1.0],
+        };
+        let edge = Curve::Spline { curve, t0: 0.0, t1: 1.0 };
+        for (x, y, z) in [(20.0, 3.0, 1.0), (1.0, 2.0, -4.0), (7.0, 7.0, 0.0)] {
+            let (p, ok) = edge.nearest(&P3::new(x, y, z));
+            let e = V3::new(x, y, 0.0).normalize() * 10.0;
+            assert!(ok && (p.coords - e).norm() < 1e-9, "{p}");
+        }
+        let (p, ok) = edge.nearest(&P3::new(5.0, -9.0, 0.0));
+        assert!(ok && (p - P3::new(10.0, 0.0, 0.0)).norm() < 1e-12, "{p}");
+    }
+}

@@ -1,0 +1,624 @@
+//! STEP models (AP203, AP214, AP242 B-reps): every ADVANCED_FACE becomes a [`Face`] on camkit's
+//! exact surface of its kind (PLANE, CYLINDRICAL_SURFACE, CONICAL_SURFACE, SPHERICAL_SURFACE,
+//! TOROIDAL_SURFACE as analytic surfaces placed by their AXIS2_PLACEMENT_3D;
+//! B_SPLINE_SURFACE_WITH_KNOTS, rational or not, as a patch) trimmed by its loops (LINE, CIRCLE and
+//! B_SPLINE_CURVE_WITH_KNOTS edges, also under SURFACE_CURVE / SEAM_CURVE), in millimetres
+//! whatever the file's length unit. Any other surface or curve is an unsupported entity: an input
+//! error naming it and its `#id`, or with `skip` a warning and the face left out.
+
+use super::analytic::Analytic;
+use super::face::{Carrier, Curve, Face, SplineCurve};
+use super::part21::{Exchange, Instance, Param};
+use super::patch::BSpline;
+use super::{Geometry, Surface};
+use crate::doc::model::MAX_DEGREE;
+use crate::error::{Error, Location, Result};
+use crate::geom::{P3, V3};
+use crate::io::Input;
+use nalgebra::{Isometry3, Matrix3, Rotation3, Translation3, UnitQuaternion};
+use std::f64::consts::TAU;
+
+/// The surface entities read.
+const SURFACES: &str =
+    "PLANE, CYLINDRICAL_SURFACE, CONICAL_SURFACE, SPHERICAL_SURFACE, TOROIDAL_SURFACE, B_SPLINE_SURFACE_WITH_KNOTS";
+
+/// The edge curve entities read.
+const CURVES: &str = "LINE, CIRCLE, B_SPLINE_CURVE_WITH_KNOTS (also as SURFACE_CURVE or SEAM_CURVE)";
+
+/// Why a face could not be read.
+enum Problem {
+    /// An entity the reader does not take; the face can be left out.
+    Unsupported(Error),
+    /// A malformed file.
+    Invalid(Error),
+}
+
+type Res<T> = std::result::Result<T, Problem>;
+
+/// The file being read: its instances, name and units.
+struct Reader<'a> {
+    ex: &'a Exchange,
+    file: &'a str,
+    /// Millimetres per length unit of the file.
+    mm: f64,
+    /// Radians per plane angle unit.
+    rad: f64,
+}
+
+/// Reads a STEP file's faces as surfaces; `skip` leaves faces with unsupported entities out
+/// (with a warning each) instead of refusing the file.
+pub fn load(input: &Input, skip: bool) -> Result<Vec<Surface>> {
+    let ex = Exchange::parse(input.text()?, &input.name)?;
+    let mut r = Reader { ex: &ex, file: &input.name, mm: 1.0, rad: 1.0 };
+    r.mm = r.unit("LENGTH_UNIT", "METRE", 1000.0).map_err(problem_error)?;
+    r.rad = r.unit("PLANE_ANGLE_UNIT", "RADIAN", 1.0).map_err(problem_error)?;
+    let mut faces: Vec<usize> = ex
+        .instances
+        .iter()
+        .filter(|(_, i)| i.parts.len() == 1 && i.parts[0].0 == "ADVANCED_FACE")
+        .map(|(k, _)| *k)
+        .collect();
+    faces.sort_unstable();
+    if faces.is_empty() {
+        return Err(Error::input(
+            "no surfaces: the STEP file holds no ADVANCED_FACE (a B-rep's faces); wireframe and tessellated STEP are not read",
+        )
+        .at(Location::file(&input.name)));
+    }
+    let mut out = Vec::new();
+    for id in faces {
+        match r.face(id) {
+            Ok(s) => out.push(s),
+            Err(Problem::Unsupported(e)) if skip => crate::cli::warn(&format!("{e}; face #{id} left out")),
+            Err(Problem::Unsupported(e)) => {
+                return Err(Error { message: format!("{}; --skip-unsupported leaves such faces out", e.message), ..e });
+            }
+            Err(Problem::Invalid(e)) => return Err(e),
+        }
+    }
+    if out.is_empty() {
+        return Err(
+            Error::input("no surfaces: every face of the STEP file was left out").at(Location::file(&input.name))
+        );
+    }
+    Ok(out)
+}
+
+fn problem_error(p: Problem) -> Error {
+    match p {
+        Problem::Unsupported(e) | Problem::Invalid(e) => e,
+    }
+}
+
+impl Reader<'_> {
+    fn at(&self, id: usize) -> Location {
+        let line = self.ex.instances.get(&id).map_or(0, |i| i.line);
+        Location::file(self.file).line(line)
+    }
+
+    fn invalid(&self, id: usize, what: impl std::fmt::Display) -> Problem {
+        Problem::Invalid(Error::input(format!("#{id}: {what}")).at(self.at(id)))
+    }
+
+    fn unsupported(&self, id: usize, role: &str, read: &str) -> Problem {
+        let k = self.ex.instances.get(&id).map_or(String::new(), Instance::keyword);
+        Problem::Unsupported(
+            Error::input(format!("unsupported entity {k} #{id} ({role}): the STEP reader takes {read}"))
+                .at(self.at(id)),
+        )
+    }
+
+    fn get(&self, id: usize) -> Res<&Instance> {
+        self.ex.instances.get(&id).ok_or_else(|| {
+            Problem::Invalid(Error::input(format!("#{id} is referenced but not defined")).at(Location::file(self.file)))
+        })
+    }
+
+    /// The parameters of `id`'s part named `keyword`.
+    fn part(&self, id: usize, keyword: &str) -> Res<&[Param]> {
+        self.get(id)?.part(keyword).ok_or_else(|| self.invalid(id, format!("expected {keyword}")))
+    }
+
+    fn num(&self, id: usize, p: &[Param], i: usize) -> Res<f64> {
+        match p.get(i) {
+            Some(Param::Num(v)) => Ok(*v),
+            Some(Param::Typed(_, v)) if matches!(v.first(), Some(Param::Num(_))) => self.num(id, v, 0),
+            _ => Err(self.invalid(id, format!("parameter {} should be a number", i + 1))),
+        }
+    }
+
+    fn reference(&self, id: usize, p: &[Param], i: usize) -> Res<usize> {
+        match p.get(i) {
+            Some(Param::Ref(r)) => Ok(*r),
+            _ => Err(self.invalid(id, format!("parameter {} should be a reference #n", i + 1))),
+        }
+    }
+
+    fn list<'p>(&self, id: usize, p: &'p [Param], i: usize) -> Res<&'p [Param]> {
+        match p.get(i) {
+            Some(Param::List(l)) => Ok(l),
+            _ => Err(self.invalid(id, format!("parameter {} should be a list", i + 1))),
+        }
+    }
+
+    fn boolean(&self, id: usize, p: &[Param], i: usize) -> Res<bool> {
+        match p.get(i) {
+            Some(Param::Enum(e)) if e == "T" => Ok(true),
+            Some(Param::Enum(e)) if e == "F" => Ok(false),
+            _ => Err(self.invalid(id, format!("parameter {} should be .T. or .F.", i + 1))),
+        }
+    }
+
+    fn nums(&self, id: usize, p: &[Param]) -> Res<Vec<f64>> {
+        (0..p.len()).map(|i| self.num(id, p, i)).collect()
+    }
+
+    fn refs(&self, id: usize, p: &[Param]) -> Res<Vec<usize>> {
+        (0..p.len()).map(|i| self.reference(id, p, i)).collect()
+    }
+
+    /// The size of the file's unit of `kind` in `base` units: an SI unit with its prefix, or a
+    /// conversion-based one (INCH, DEGREE) through its measure; 1 when the file names none.
+    fn unit(&self, kind: &str, si: &str, per_si: f64) -> Res<f64> {
+        let mut ids: Vec<usize> =
+            self.ex.instances.iter().filter(|(_, i)| i.part(kind).is_some()).map(|(k, _)| *k).collect();
+        ids.sort_unstable();
+        // The unit the geometry's context assigns, else the first of the kind.
+        let assigned =
+            self.ex.instances.values().filter_map(|i| i.part("GLOBAL_UNIT_ASSIGNED_CONTEXT")).find_map(|p| {
+                let Some(Param::List(units)) = p.first() else { return None };
+                units.iter().find_map(|u| match u {
+                    Param::Ref(r) if ids.contains(r) => Some(*r),
+                    _ => None,
+                })
+            });
+        let Some(id) = assigned.or(ids.first().copied()) else { return Ok(1.0) };
+        self.unit_of(id, si, per_si)
+    }
+
+    fn unit_of(&self, id: usize, si: &str, per_si: f64) -> Res<f64> {
+        let inst = self.get(id)?;
+        if let Some(p) = inst.part("SI_UNIT") {
+            let prefix = match p.first() {
+                Some(Param::Enum(e)) => match e.as_str() {
+                    "MILLI" => 1e-3,
+                    "CENTI" => 1e-2,
+                    "DECI" => 1e-1,
+                    "MICRO" => 1e-6,
+                    "KILO" => 1e3,
+                    _ => return Err(self.invalid(id, format!("unit prefix .{e}. is not read"))),
+                },
+                _ => 1.0,
+            };
+            return match p.get(1) {
+                Some(Param::Enum(n)) if n == si => Ok(prefix * per_si),
+                _ => Err(self.invalid(id, format!("expected the SI unit .{si}.)"))),
+            };
+        }
+        if let Some(p) = inst.part("CONVERSION_BASED_UNIT") {
+            let m = self.reference(id, p, 1)?;
+            let mp = &self.get(m)?.parts[0].1;
+            let factor = self.num(m, mp, 0)?;
+            let base = self.reference(m, mp, 1)?;
+            return Ok(factor * self.unit_of(base, si, per_si)?);
+        }
+        Err(self.invalid(id, "the unit is neither an SI_UNIT nor a CONVERSION_BASED_UNIT"))
+    }
+
+    /// A CARTESIAN_POINT in mm.
+    fn point(&self, id: usize) -> Res<P3> {
+        let p = self.part(id, "CARTESIAN_POINT")?;
+        let c = self.nums(id, self.list(id, p, 1)?)?;
+        if c.len() != 3 {
+            return Err(self.invalid(id, "a 3-D point needs three coordinates"));
+        }
+        Ok(P3::new(c[0], c[1], c[2]) * self.mm)
+    }
+
+    /// A DIRECTION, unit.
+    fn direction(&self, id: usize) -> Res<V3> {
+        let p = self.part(id, "DIRECTION")?;
+        let c = self.nums(id, self.list(id, p, 1)?)?;
+        if c.len() != 3 {
+            return Err(self.invalid(id, "a 3-D direction needs three components"));
+        }
+        V3::new(c[0], c[1], c[2]).try_normalize(1e-300).ok_or_else(|| self.invalid(id, "a zero direction"))
+    }
+
+    /// An AXIS2_PLACEMENT_3D as the rigid motion from its frame to the model's.
+    fn axis2(&self, id: usize) -> Res<Isometry3<f64>> {
+        let p = self.part(id, "AXIS2_PLACEMENT_3D")?;
+        let origin = self.point(self.reference(id, p, 1)?)?;
+        let z = match p.get(2) {
+            Some(Param::Ref(d)) => self.direction(*d)?,
+            _ => V3::z(),
+        };
+        let x0 = match p.get(3) {
+            Some(Param::Ref(d)) => self.direction(*d)?,
+            _ => super::analytic::any_perpendicular(&z),
+        };
+        let x = (x0 - z * x0.dot(&z))
+            .try_normalize(1e-12)
+            .ok_or_else(|| self.invalid(id, "ref_direction is parallel to the axis"))?;
+        let rot = Rotation3::from_matrix_unchecked(Matrix3::from_columns(&[x, z.cross(&x), z]));
+        Ok(Isometry3::from_parts(Translation3::from(origin.coords), UnitQuaternion::from_rotation_matrix(&rot)))
+    }
+
+    /// A face as a surface of the model.
+    fn face(&self, id: usize) -> Res<Surface> {
+        let p = self.part(id, "ADVANCED_FACE")?;
+        let bounds = self.refs(id, self.list(id, p, 1)?)?;
+        let sid = self.reference(id, p, 2)?;
+        let same_sense = self.boolean(id, p, 3)?;
+        let s = self.get(sid)?;
+        let analytic = ["PLANE", "CYLINDRICAL_SURFACE", "CONICAL_SURFACE", "SPHERICAL_SURFACE", "TOROIDAL_SURFACE"];
+        let kind = s.parts[0].0.as_str();
+        let placement = if s.parts.len() == 1 && analytic.contains(&kind) {
+            let sp = &s.parts[0].1;
+            Some(self.axis2(self.reference(sid, sp, 1)?)?)
+        } else {
+            None
+        };
+        let to_local = |q: P3| placement.map_or(q, |iso| iso.inverse_transform_point(&q));
+        let vec_local = |v: V3| placement.map_or(v, |iso| iso.inverse_transform_vector(&v));
+        let mut loops = Vec::new();
+        for b in bounds {
+            let bp = match self.get(b)?.parts[0].0.as_str() {
+                "FACE_BOUND" => self.part(b, "FACE_BOUND")?,
+                "FACE_OUTER_BOUND" => self.part(b, "FACE_OUTER_BOUND")?,
+                _ => return Err(self.invalid(b, "expected FACE_BOUND or FACE_OUTER_BOUND")),
+            };
+            let lid = self.reference(b, bp, 1)?;
+            let orientation = self.boolean(b, bp, 2)?;
+            let lp = self.get(lid)?;
+            if lp.part("VERTEX_LOOP").is_some() {
+                continue; // a degenerate loop (a cone's apex, a sphere's pole) bounds nothing
+            }
+            let lp = self.part(lid, "EDGE_LOOP")?;
+            let mut edges = Vec::new();
+            for oe in self.refs(lid, self.list(lid, lp, 1)?)? {
+                let op = self.part(oe, "ORIENTED_EDGE")?;
+                let eid = self.reference(oe, op, 3)?;
+                let along = self.boolean(oe, op, 4)?;
+                let ep = self.part(eid, "EDGE_CURVE")?;
+                let vertex = |i: usize| -> Res<P3> {
+                    let v = self.reference(eid, ep, i)?;
+                    let vp = self.part(v, "VERTEX_POINT")?;
+                    self.point(self.reference(v, vp, 1)?)
+                };
+                let (v1, v2) = (to_local(vertex(1)?), to_local(vertex(2)?));
+                let sense = self.boolean(eid, ep, 4)?;
+                // The curve's own order runs from a to b.
+                let (a, b) = if sense { (v1, v2) } else { (v2, v1) };
+                let curve = self.curve(self.reference(eid, ep, 3)?, a, b, &to_local, &vec_local)?;
+                edges.push((curve, sense == along));
+            }
+            if !orientation {
+                edges = edges.into_iter().rev().map(|(c, f)| (c, !f)).collect();
+            }
+            loops.push(edges);
+        }
+        let zrange = || {
+            let b = loops.iter().flatten().fold(super::Aabb::empty(), |b, (c, _)| b.union(&c.bounds()));
+            (b.min.z, b.max.z)
+        };
+        let sp = &s.parts[0].1;
+        let carrier = match (s.parts.len(), kind) {
+            (1, "PLANE") => Carrier::Analytic(Analytic::Plane { point: P3::origin(), normal: V3::z() }),
+            (1, "CYLINDRICAL_SURFACE") => {
+                let (from, to) = zrange();
+                Carrier::Analytic(Analytic::Cylinder {
+                    point: P3::origin(),
+                    axis: V3::z(),
+                    radius: self.length(sid, sp, 2)?,
+                    from,
+                    to,
+                })
+            }
+            (1, "CONICAL_SURFACE") => {
+                let r = self.num(sid, sp, 2)? * self.mm;
+                let angle = self.num(sid, sp, 3)? * self.rad;
+                if !(angle > 0.0 && angle < TAU / 4.0) || r < 0.0 {
+                    return Err(self.invalid(sid, "a cone needs 0 < semi_angle < 90° and radius ≥ 0"));
+                }
+                let back = r / angle.tan();
+                let (from, to) = zrange();
+                Carrier::Analytic(Analytic::Cone {
+                    apex: P3::new(0.0, 0.0, -back),
+                    axis: V3::z(),
+                    half_angle: angle,
+                    from: (from + back).max(0.0),
+                    to: to + back,
+                })
+            }
+            (1, "SPHERICAL_SURFACE") => {
+                Carrier::Analytic(Analytic::Sphere { centre: P3::origin(), radius: self.length(sid, sp, 2)? })
+            }
+            (1, "TOROIDAL_SURFACE") => Carrier::Analytic(Analytic::Torus {
+                centre: P3::origin(),
+                axis: V3::z(),
+                major: self.length(sid, sp, 2)?,
+                minor: self.length(sid, sp, 3)?,
+            }),
+            _ if s.part("B_SPLINE_SURFACE_WITH_KNOTS").is_some() => Carrier::Patch(self.bspline_surface(sid)?),
+            _ => return Err(self.unsupported(sid, &format!("the surface of face #{id}"), SURFACES)),
+        };
+        let kind = match &carrier {
+            Carrier::Analytic(Analytic::Plane { .. }) => "plane",
+            Carrier::Analytic(Analytic::Cylinder { .. }) => "cylinder",
+            Carrier::Analytic(Analytic::Cone { .. }) => "cone",
+            Carrier::Analytic(Analytic::Sphere { .. }) => "sphere",
+            Carrier::Analytic(Analytic::Torus { .. }) => "torus",
+            Carrier::Patch(_) => "bspline",
+        };
+        let face = Face::new(carrier, loops, same_sense);
+        Ok(Surface::new(format!("{kind}#{id}"), Geometry::Face(Box::new(face)), placement, !same_sense))
+    }
+
+    /// A positive length parameter in mm.
+    fn length(&self, id: usize, p: &[Param], i: usize) -> Res<f64> {
+        let v = self.num(id, p, i)? * self.mm;
+        if v > 0.0 { Ok(v) } else { Err(self.invalid(id, format!("parameter {} must be a positive length", i + 1))) }
+    }
+
+    /// An edge's curve in the face's frame, from `a` to `b` in the curve's own order.
+    fn curve(&self, cid: usize, a: P3, b: P3, to_local: &dyn Fn(P3) -> P3, vec_local: &dyn Fn(V3) -> V3) -> Res<Curve> {
+        let c = self.get(cid)?;
+        let k = c.parts[0].0.as_str();
+        if c.parts.len() == 1 && matches!(k, "SURFACE_CURVE" | "SEAM_CURVE" | "INTERSECTION_CURVE") {
+            let inner = self.reference(cid, &c.parts[0].1, 1)?;
+            return self.curve(inner, a, b, to_local, vec_local);
+        }
+        match (c.parts.len(), k) {
+            (1, "LINE") => Ok(Curve::Line { a, b }),
+            (1, "CIRCLE") => {
+                let p = &c.parts[0].1;
+                let iso = self.axis2(self.reference(cid, p, 1)?)?;
+                let radius = self.length(cid, p, 2)?;
+                let centre = to_local(iso * P3::origin());
+                let (x, y) = (vec_local(iso * V3::x()), vec_local(iso * V3::y()));
+                let angle = |q: P3| (q - centre).dot(&y).atan2((q - centre).dot(&x));
+                let t0 = angle(a);
+                let mut t1 = t0 + (angle(b) - t0).rem_euclid(TAU);
+                if t1 - t0 < 1e-12 {
+                    t1 += TAU; // a closed edge: the whole circle
+                }
+                Ok(Curve::Arc { centre, x, y, radius, t0, t1 })
+            }
+            _ if c.part("B_SPLINE_CURVE_WITH_KNOTS").is_some() => {
+                let mut curve = self.bspline_curve(cid)?;
+                curve.ctrl = curve.ctrl.into_iter().map(to_local).collect();
+                let [d0, d1] = curve.domain();
+                let (t0, t1) = if (a - b).norm() <= 1e-9 * (1.0 + a.coords.norm()) {
+                    (d0, d1)
+                } else {
+                    let ta = curve.nearest(&a, d0, d1).0;
+                    let tb = curve.nearest(&b, d0, d1).0;
+                    (ta.min(tb), ta.max(tb))
+                };
+                Ok(Curve::Spline { curve, t0, t1 })
+            }
+            _ => Err(self.unsupported(cid, "an edge curve", CURVES)),
+        }
+    }
+
+    /// Knots from distinct values and multiplicities.
+    fn knots(&self, id: usize, mults: &[Param], values: &[Param]) -> Res<Vec<f64>> {
+        let m = self.nums(id, mults)?;
+        let v = self.nums(id, values)?;
+        if m.len() != v.len() || m.iter().any(|x| *x < 1.0 || x.fract() != 0.0) {
+            return Err(self.invalid(id, "knot multiplicities and knots must pair up"));
+        }
+        Ok(v.iter().zip(&m).flat_map(|(k, n)| std::iter::repeat_n(*k, *n as usize)).collect())
+    }
+
+    /// A B_SPLINE_CURVE_WITH_KNOTS, simple or complex (rational), in the file's frame (mm).
+    fn bspline_curve(&self, id: usize) -> Res<SplineCurve> {
+        let inst = self.get(id)?;
+        let (head, tail) = match inst.part("B_SPLINE_CURVE") {
+            Some(h) => (h, self.part(id, "B_SPLINE_CURVE_WITH_KNOTS")?),
+            None => {
+                let p = self.part(id, "B_SPLINE_CURVE_WITH_KNOTS")?;
+                (&p[1..], &p[6..])
+            }
+        };
+        let degree = self.num(id, head, 0)?;
+        let ctrl =
+            self.refs(id, self.list(id, head, 1)?)?.into_iter().map(|c| self.point(c)).collect::<Res<Vec<_>>>()?;
+        let knots = self.knots(id, self.list(id, tail, 0)?, self.list(id, tail, 1)?)?;
+        let weights = match inst.part("RATIONAL_B_SPLINE_CURVE") {
+            Some(w) => Some(self.nums(id, self.list(id, w, 0)?)?),
+            None => None,
+        };
+        let p = degree as usize;
+        if degree.fract() != 0.0 || !(1..=MAX_DEGREE).contains(&p) {
+            return Err(self.invalid(id, format!("curve degree must be 1 to {MAX_DEGREE}")));
+        }
+        if knots.len() != ctrl.len() + p + 1
+            || knots.windows(2).any(|w| w[1] < w[0])
+            || weights.as_ref().is_some_and(|w| w.len() != ctrl.len() || w.iter().any(|x| *x <= 0.0))
+        {
+            return Err(self.invalid(id, "knots, control points and weights do not fit together"));
+        }
+        Ok(SplineCurve { degree: p, ctrl, weights, knots })
+    }
+
+    /// A B_SPLINE_SURFACE_WITH_KNOTS, simple or complex (rational), in mm.
+    fn bspline_surface(&self, id: usize) -> Res<BSpline> {
+        let inst = self.get(id)?;
+        let (head, tail) = match inst.part("B_SPLINE_SURFACE") {
+            Some(h) => (h, self.part(id, "B_SPLINE_SURFACE_WITH_KNOTS")?),
+            None => {
+                let p = self.part(id, "B_SPLINE_SURFACE_WITH_KNOTS")?;
+                (&p[1..], &p[8..])
+            }
+        };
+        let degree = [self.num(id, head, 0)?, self.num(id, head, 1)?];
+        let mut net = Vec::new();
+        for row in self.list(id, head, 2)? {
+            let Param::List(row) = row else { return Err(self.invalid(id, "control points must be a list of lists")) };
+            net.push(self.refs(id, row)?.into_iter().map(|c| self.point(c)).collect::<Res<Vec<_>>>()?);
+        }
+        let weights = match inst.part("RATIONAL_B_SPLINE_SURFACE") {
+            Some(w) => {
+                let mut rows = Vec::new();
+                for row in self.list(id, w, 0)? {
+                    let Param::List(row) = row else { return Err(self.invalid(id, "weights must be a list of lists")) };
+                    rows.push(self.nums(id, row)?);
+                }
+                Some(rows)
+            }
+            None => None,
+        };
+        let ku = self.knots(id, self.list(id, tail, 0)?, self.list(id, tail, 2)?)?;
+        let kv = self.knots(id, self.list(id, tail, 1)?, self.list(id, tail, 3)?)?;
+        let (p, q) = (degree[0] as usize, degree[1] as usize);
+        let (nu, nv) = (net.len(), net.first().map_or(0, Vec::len));
+        let fits = degree.iter().all(|d| d.fract() == 0.0 && (1.0..=MAX_DEGREE as f64).contains(d))
+            && nu > p
+            && nv > q
+            && net.iter().all(|r| r.len() == nv)
+            && ku.len() == nu + p + 1
+            && kv.len() == nv + q + 1
+            && ku.windows(2).chain(kv.windows(2)).all(|w| w[1] >= w[0])
+            && ku[p] < ku[nu]
+            && kv[q] < kv[nv]
+            && weights.as_ref().is_none_or(|w| {
+                w.len() == nu && w.iter().all(|r| r.len() == nv && r.iter().all(|x| x.is_finite() && *x > 0.0))
+            });
+        if !fits {
+            return Err(self.invalid(
+                id,
+                format!("degrees (1 to {MAX_DEGREE}), knots, control points and weights do not fit together"),
+            ));
+        }
+        Ok(BSpline::with_weights(&net, weights.as_deref(), [p, q], Some(ku), Some(kv)))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::Model;
+
+    fn block() -> Model {
+        let data = include_bytes!("../../../../data/step/block.step").to_vec();
+        Model::load(&Input { name: "block.step".into(), data }).unwrap()
+    }
+
+    /// The block of `scripts/step-models.py` against its closed forms: nearest points, distances
+    /// and outward normals (out of the material) on every kind of face.
+    #[test]
+    fn block_faces_against_closed_forms() {
+        let m = block();
+        let kinds: Vec<&str> = m.surfaces.iter().map(|s| s.name.split('#').next().unwrap()).collect();
+        for (k, n) in [("plane", 7), ("cylinder", 5), ("sphere", 1), ("torus", 1)] {
+            assert_eq!(kinds.iter().filter(|x| **x == k).count(), n, "{kinds:?}");
+        }
+        let dish = P3::new(50.0, 50.0, 70.0);
+        let hole = P3::new(85.0, 85.0, 38.0);
+        let check = |q: P3, point: P3, normal: V3, kind: &str| {
+            let n = m.nearest(&q);
+            assert!(m.surfaces[n.surface].name.starts_with(kind), "{q}: {}", m.surfaces[n.surface].name);
+            assert!((n.point - point).norm() < 1e-10, "{q}: {} vs {point}", n.point);
+            assert!((n.normal - normal).norm() < 1e-10, "{q}: normal {} vs {normal}", n.normal);
+            assert!(n.converged);
+        };
+        // The dish: the sphere's foot, normal towards the centre (out of the material).
+        for q in [P3::new(50.0, 50.0, 45.0), P3::new(60.0, 45.0, 38.0), P3::new(45.0, 55.0, 42.0)] {
+            let u = (q - dish).normalize();
+            check(q, dish + u * 40.0, -u, "sphere");
+        }
+        // High over the dish the top plane's hole rim is nearer than the dish's bottom.
+        let q = P3::new(50.0, 50.0, 100.0);
+        let n = m.nearest(&q);
+        let rim = (40.0f64 * 40.0 - 30.0 * 30.0).sqrt();
+        assert!((n.distance - rim.hypot(60.0)).abs() < 1e-10 && (n.point.z - 40.0).abs() < 1e-12, "{}", n.point);
+        // The top plane beside the dish and its fillet-rimmed hole.
+        check(P3::new(20.0, 80.0, 47.0), P3::new(20.0, 80.0, 40.0), V3::z(), "plane");
+        // The hole's wall (normal towards its axis), its floor, and the torus rounding its rim.
+        check(P3::new(85.0, 88.0, 30.0), P3::new(85.0, 91.0, 30.0), -V3::y(), "cylinder");
+        check(P3::new(84.0, 85.0, 26.0), P3::new(84.0, 85.0, 25.0), V3::z(), "plane");
+        let q = P3::new(85.0 - 6.5, 85.0, 39.5);
+        let tube = hole + V3::new(-8.0, 0.0, 0.0);
+        let u = (q - tube).normalize();
+        check(q, tube + u * 2.0, u, "torus");
+        // A vertical corner fillet R8 round (8, 8) and a side.
+        let q = P3::new(2.0, 3.0, 20.0);
+        let u = V3::new(-6.0, -5.0, 0.0).normalize();
+        check(q, P3::new(8.0, 8.0, 20.0) + u * 8.0, u, "cylinder");
+        check(P3::new(-5.0, 50.0, 20.0), P3::new(0.0, 50.0, 20.0), -V3::x(), "plane");
+        check(P3::new(50.0, 50.0, -3.0), P3::new(50.0, 50.0, 0.0), -V3::z(), "plane");
+    }
+
+    fn step(body: &str) -> String {
+        format!("ISO-10303-21;\nHEADER;\nENDSEC;\nDATA;\n{body}ENDSEC;\nEND-ISO-10303-21;\n")
+    }
+
+    fn load(text: &str, skip: bool) -> Result<Model> {
+        Model::load_with(&Input { name: "t.stp".into(), data: text.as_bytes().to_vec() }, skip)
+    }
+
+    /// One square face 0..10 on the plane z = 0 in the given unit, and a face on a surface of
+    /// revolution.
+    fn square(unit: &str, second_surface: &str) -> String {
+        let mut s = String::from(
+            "#1 = CARTESIAN_POINT('',(0.,0.,0.));\n#2 = DIRECTION('',(0.,0.,1.));\n#3 = DIRECTION('',(1.,0.,0.));\n\
+             #4 = AXIS2_PLACEMENT_3D('',#1,#2,#3);\n#5 = PLANE('',#4);\n",
+        );
+        let c = [(0, 0), (10, 0), (10, 10), (0, 10)];
+        for (k, (x, y)) in c.iter().enumerate() {
+            s += &format!(
+                "#{} = CARTESIAN_POINT('',({x}.,{y}.,0.));\n#{} = VERTEX_POINT('',#{});\n",
+                10 + k,
+                20 + k,
+                10 + k
+            );
+        }
+        for k in 0..4 {
+            s += &format!(
+                "#{} = EDGE_CURVE('',#{},#{},#{},.T.);\n#{} = ORIENTED_EDGE('',*,*,#{},.T.);\n#{} = LINE('',#{},#99);\n",
+                30 + k,
+                20 + k,
+                20 + (k + 1) % 4,
+                50 + k,
+                40 + k,
+                30 + k,
+                50 + k,
+                10 + k
+            );
+        }
+        s += "#99 = VECTOR('',#3,1.);\n#60 = EDGE_LOOP('',(#40,#41,#42,#43));\n#61 = FACE_OUTER_BOUND('',#60,.T.);\n\
+              #62 = ADVANCED_FACE('',(#61),#5,.T.);\n";
+        s += &format!("#70 = ( LENGTH_UNIT() NAMED_UNIT(*) {unit} );\n");
+        s += second_surface;
+        s
+    }
+
+    #[test]
+    fn units_and_unsupported_entities() {
+        let m = load(&step(&square("SI_UNIT(.MILLI.,.METRE.)", "")), false).unwrap();
+        let n = m.nearest(&P3::new(5.0, 20.0, 3.0));
+        assert!((n.point - P3::new(5.0, 10.0, 0.0)).norm() < 1e-12, "{}", n.point);
+        let m = load(&step(&square("SI_UNIT($,.METRE.)", "")), false).unwrap();
+        assert!((m.nearest(&P3::new(5e3, 2e4, 3.0)).point - P3::new(5e3, 1e4, 0.0)).norm() < 1e-9);
+        let inch = "CONVERSION_BASED_UNIT('INCH',#71) );\n#71 = LENGTH_MEASURE_WITH_UNIT(LENGTH_MEASURE(25.4),#72);\n\
+                    #72 = ( LENGTH_UNIT() NAMED_UNIT(*) SI_UNIT(.MILLI.,.METRE.)";
+        let m = load(&step(&square(inch, "")), false).unwrap();
+        assert!((m.nearest(&P3::new(100.0, 500.0, 3.0)).point - P3::new(100.0, 254.0, 0.0)).norm() < 1e-9);
+        let revolved = "#80 = SURFACE_OF_REVOLUTION('',#50,#81);\n#81 = AXIS1_PLACEMENT('',#1,#2);\n\
+                        #82 = ADVANCED_FACE('',(#61),#80,.T.);\n";
+        let e = load(&step(&square("SI_UNIT(.MILLI.,.METRE.)", revolved)), false).unwrap_err();
+        assert_eq!(e.exit_status(), 2);
+        assert!(
+            e.to_string()
+                .starts_with("t.stp:35: unsupported entity SURFACE_OF_REVOLUTION #80 (the surface of face #82)")
+                && e.to_string().ends_with("--skip-unsupported leaves such faces out"),
+            "{e}"
+        );
+        let m = load(&step(&square("SI_UNIT(.MILLI.,.METRE.)", revolved)), true).unwrap();
+        assert_eq!(m.surfaces.len(), 1);
+        let e = load(&step("#1 = CARTESIAN_POINT('',(0.,0.,0.));\n"), false).unwrap_err();
+        assert!(e.to_string().starts_with("t.stp: no surfaces"), "{e}");
+    }
+}

@@ -1,0 +1,219 @@
+//! End-to-end tests of STEP models (data/step, made by `freecadcmd scripts/step-models.py`):
+//! `stylus-trace` on STEP faces against the same surfaces as a model JSON document and against
+//! closed forms, the B-spline face's CL identical to the model JSON's, and bad STEP input refused
+//! with one line (exit 2) or, with --skip-unsupported, the face left out with a warning.
+
+use camkit::geom::{P3, V3};
+use e2e::{Work, data};
+
+const BIN: &str = "stylus-trace";
+
+/// What the issue promises on analytic faces: 0.1 µm.
+const EXACT: f64 = 1e-4;
+
+/// Rows of a CL table as name → text maps.
+fn table(text: &str) -> Vec<Vec<(String, String)>> {
+    let mut lines = text.lines();
+    let header: Vec<String> = lines.next().expect("header").split(',').map(str::to_string).collect();
+    lines.map(|l| header.iter().cloned().zip(l.split(',').map(str::to_string)).collect()).collect()
+}
+
+fn num(row: &[(String, String)], key: &str) -> f64 {
+    row.iter().find(|(k, _)| k == key).map(|(_, v)| v.parse().unwrap()).unwrap_or_else(|| panic!("no {key}"))
+}
+
+fn text<'a>(row: &'a [(String, String)], key: &str) -> &'a str {
+    row.iter().find(|(k, _)| k == key).map(|(_, v)| v.as_str()).unwrap()
+}
+
+fn p3(row: &[(String, String)], x: &str, y: &str, z: &str) -> P3 {
+    P3::new(num(row, x), num(row, y), num(row, z))
+}
+
+/// The signed distance of a point from a closed-form surface.
+type Offset = dyn Fn(&P3) -> f64;
+
+/// Traces `model` (a path under data/) over `region` with a stylus of radius 3.
+fn trace(w: &Work, model: &str, region: &str, out: &str) -> Vec<Vec<(String, String)>> {
+    let m = data(model).display().to_string();
+    let region = format!("--region={region}");
+    w.run(BIN, &[&m, "-r", "3", "--pick", "2", &region, "--contact-tol", "1e-6", "-q", "-o", out], b"").ok();
+    table(&w.read(out))
+}
+
+/// The STEP halves of a sphere, a cylinder and a torus (faces.step) against the same surfaces as a
+/// model JSON document (faces.json): over each, the CL points are those of the JSON model (the
+/// same points on the sphere and the cylinder; on the torus, whose steps round differently near
+/// its axis, each on the closed-form CL surface) and within 0.1 µm of the closed form.
+#[test]
+fn step_faces_agree_with_the_analytic_model() {
+    let w = Work::new();
+    let cases: [(&str, &Offset); 3] = [
+        ("-15,15,-15,15", &|c: &P3| c.coords.norm() - 20.0),
+        ("45,95,-12,12", &|c: &P3| c.y.hypot(c.z) - 10.0),
+        ("-14,14,48,72", &|c: &P3| (c.x.hypot(c.y - 60.0) - 10.0).hypot(c.z) - 6.0),
+    ];
+    for (k, (region, off)) in cases.iter().enumerate() {
+        let step = trace(&w, "step/faces.step", region, "s.csv");
+        let json = trace(&w, "step/faces.json", region, "j.csv");
+        assert!(step.len() > 300 && step.len() == json.len(), "{region}: {} vs {} rows", step.len(), json.len());
+        let worst = step.iter().map(|r| (off(&p3(r, "x", "y", "z")) - 3.0).abs()).fold(0.0, f64::max);
+        assert!(worst <= EXACT, "{region}: CL off the closed form by {worst}");
+        if k < 2 {
+            for (a, b) in step.iter().zip(&json) {
+                let d = (p3(a, "x", "y", "z") - p3(b, "x", "y", "z")).norm();
+                assert!(d <= 1e-12, "{region}: STEP and JSON CL differ by {d}");
+            }
+        }
+    }
+}
+
+/// A B-spline face (natural boundary) and the same surface as a model JSON document: identical CL.
+#[test]
+fn bspline_face_gives_the_json_models_cl() {
+    let w = Work::new();
+    let step = trace(&w, "step/bspline.step", "0,60,0,40", "s.csv");
+    let json = trace(&w, "step/bspline.json", "0,60,0,40", "j.csv");
+    assert!(step.len() > 500 && step.len() == json.len(), "{} vs {} rows", step.len(), json.len());
+    for (a, b) in step.iter().zip(&json) {
+        for ((ka, va), (_, vb)) in a.iter().zip(b) {
+            if ka != "surface" {
+                assert_eq!(va, vb, "column {ka}");
+            }
+        }
+    }
+}
+
+/// The block (planes, R8 corner cylinders, the R40 dish, the R6 hole and its R2 torus rim)
+/// traced whole: every contact lies on its face's closed-form surface, the stylus centre r from
+/// it, and where the contact is inside a face (along the normal) the closed-form distance of the
+/// centre from that surface is r within 0.1 µm.
+#[test]
+fn block_against_closed_forms() {
+    let w = Work::new();
+    let rows = trace(&w, "step/block.step", "0,100,0,100", "b.csv");
+    let dish = P3::new(50.0, 50.0, 70.0);
+    let corners = [(8.0, 8.0), (92.0, 8.0), (92.0, 92.0), (8.0, 92.0)];
+    let mut seen = std::collections::BTreeMap::new();
+    for r in &rows {
+        let (c, p, n) = (p3(r, "x", "y", "z"), p3(r, "px", "py", "pz"), p3(r, "nx", "ny", "nz").coords);
+        let kind = text(r, "surface").split('#').next().unwrap().to_string();
+        // Signed distance of a point from the face's surface (closed form) and its outward normal.
+        let surface = |q: &P3| -> (f64, V3) {
+            match kind.as_str() {
+                "sphere" => (40.0 - (q - dish).norm(), (dish - q).normalize()),
+                "torus" => {
+                    let (dx, dy) = (q.x - 85.0, q.y - 85.0);
+                    let rho = dx.hypot(dy);
+                    let tube = P3::new(85.0 + dx / rho * 8.0, 85.0 + dy / rho * 8.0, 38.0);
+                    ((q - tube).norm() - 2.0, (q - tube).normalize())
+                }
+                "cylinder" => {
+                    let hole = (p.x - 85.0).hypot(p.y - 85.0);
+                    if (hole - 6.0).abs() < 1e-6 {
+                        let d = V3::new(85.0 - q.x, 85.0 - q.y, 0.0);
+                        (6.0 - (q.x - 85.0).hypot(q.y - 85.0), d.normalize())
+                    } else {
+                        let (cx, cy) = *corners
+                            .iter()
+                            .min_by(|a, b| {
+                                let da = (p.x - a.0).hypot(p.y - a.1);
+                                let db = (p.x - b.0).hypot(p.y - b.1);
+                                da.total_cmp(&db)
+                            })
+                            .unwrap();
+                        let d = V3::new(q.x - cx, q.y - cy, 0.0);
+                        (d.norm() - 8.0, d.normalize())
+                    }
+                }
+                _ => {
+                    // One of the block's planes: its sides, top, bottom and the hole's floor.
+                    let planes = [(0, 0.0), (0, 100.0), (1, 0.0), (1, 100.0), (2, 0.0), (2, 40.0), (2, 25.0)];
+                    (planes.iter().map(|(k, v)| (q[*k] - v).abs()).fold(f64::INFINITY, f64::min), n)
+                }
+            }
+        };
+        let (on, normal) = surface(&p);
+        assert!(on.abs() < 1e-9, "{kind}: contact {p} is {on} off its surface");
+        assert!(((c - p).norm() - 3.0).abs() <= EXACT, "{kind}: centre {c} not r from {p}");
+        // Off the face's edges the centre lies along the surface's normal: r from the surface.
+        if ((c - p).normalize() - normal).norm() < 1e-6 && kind != "plane" {
+            let (d, _) = surface(&c);
+            assert!((d - 3.0).abs() <= EXACT, "{kind}: centre {c} is {d} from the surface");
+            *seen.entry(format!("{kind} inside")).or_insert(0) += 1;
+        }
+        *seen.entry(kind).or_insert(0) += 1;
+    }
+    for kind in ["plane", "cylinder", "sphere", "torus", "cylinder inside", "sphere inside", "torus inside"] {
+        assert!(seen.get(kind).is_some_and(|n| *n > 10), "{kind} touched too rarely: {seen:?}");
+    }
+}
+
+/// A STEP file that is not one, one with no faces, and one with an unsupported surface: one line
+/// naming file (line, entity and #id), exit 2, no output; --skip-unsupported warns and goes on.
+#[test]
+fn bad_step_input_is_refused_with_one_line() {
+    let w = Work::new();
+    let run = |file: &str, extra: &[&str]| {
+        let mut args = vec![file, "-r", "3", "-o", "out.csv", "-q"];
+        args.extend_from_slice(extra);
+        w.run(BIN, &args, b"")
+    };
+    w.write("solid.step", "solid cube\n  facet normal 0 0 1\n");
+    run("solid.step", &[]).fails(2, "solid.step:1: not a STEP file: it does not start with ISO-10303-21;");
+    w.write("empty.stp", "ISO-10303-21;\nHEADER;\nENDSEC;\nDATA;\n#1 = CARTESIAN_POINT('',(0.,0.,0.));\nENDSEC;\n");
+    run("empty.stp", &[]).fails(2, "empty.stp: no surfaces: the STEP file holds no ADVANCED_FACE");
+    w.write("bad.step", "ISO-10303-21;\nHEADER;\nENDSEC;\nDATA;\n#1 = CARTESIAN_POINT('',(0.,0.,0.);\nENDSEC;\n");
+    run("bad.step", &[]).fails(2, "bad.step:5:35: expected ',' or ')'");
+    let block = std::fs::read_to_string(data("step/block.step")).unwrap();
+    let line = block.lines().position(|l| l.contains("TOROIDAL_SURFACE")).unwrap() + 1;
+    let odd = block.replace("TOROIDAL_SURFACE('',#44,8.,2.)", "DEGENERATE_TOROIDAL_SURFACE('',#44,8.,2.,.T.)");
+    assert_ne!(odd, block);
+    w.write("odd.STP", &odd);
+    run("odd.STP", &[]).fails(
+        2,
+        &format!("odd.STP:{line}: unsupported entity DEGENERATE_TOROIDAL_SURFACE #43 (the surface of face #323)"),
+    );
+    assert!(!w.exists("out.csv"));
+    let o = run("odd.STP", &["--skip-unsupported"]);
+    o.ok();
+    assert!(o.stderr.contains("warning") && o.stderr.contains("face #323 left out"), "{}", o.stderr);
+    assert_eq!(o.stderr.trim_end().lines().count(), 1, "{}", o.stderr);
+}
+
+/// tool-attitude with --model on the STEP block: the ball end mill on the CL of the dish is
+/// clear (no row deeper than the gouge tolerance, the deepest within the faces' triangles' chord),
+/// and a contact moved 0.1 mm down is found gouging by 0.1·n_z (the normal's z), within the chord.
+#[test]
+fn tool_attitude_gouge_checks_against_step_faces() {
+    let w = Work::new();
+    let m = data("step/block.step").display().to_string();
+    w.run(BIN, &[&m, "-r", "3", "--pick", "5", "--region=30,70,30,70", "-q", "-o", "cl.csv"], b"").ok();
+    w.write("ball.json", r#"{"kind": "ball", "radius": 3}"#);
+    let args =
+        |input: &'static str| vec![input, "--tool", "ball.json", "--model", &m, "-o", "t.csv", "--report", "r.json"];
+    w.run("tool-attitude", &args("cl.csv"), b"").ok();
+    let r: serde_json::Value = serde_json::from_str(&w.read("r.json")).unwrap();
+    let chord = r["gouge_chord_mm"].as_f64().unwrap();
+    assert!(chord > 0.0 && chord < 1e-3, "{r}");
+    assert_eq!(r["gouge_rows"], 0, "{r}");
+    assert!(r["largest_gouge_mm"].as_f64().unwrap() <= chord + 1e-9, "{r}");
+    // One contact 0.1 mm lower.
+    let cl = w.read("cl.csv");
+    let rows = table(&cl);
+    let k = rows.len() / 2;
+    let nz = num(&rows[k], "nz");
+    let mut lines: Vec<String> = cl.lines().map(str::to_string).collect();
+    let header: Vec<&str> = lines[0].split(',').collect();
+    let (iz, ipz) = (header.iter().position(|h| *h == "z").unwrap(), header.iter().position(|h| *h == "pz").unwrap());
+    let mut f: Vec<String> = lines[k + 1].split(',').map(str::to_string).collect();
+    for i in [iz, ipz] {
+        f[i] = (f[i].parse::<f64>().unwrap() - 0.1).to_string();
+    }
+    lines[k + 1] = f.join(",");
+    w.write("low.csv", lines.join("\n") + "\n");
+    let o = w.run("tool-attitude", &args("low.csv"), b"");
+    o.fails(1, &format!("low.csv:{}: 1 row(s) gouge the model by more than 0.001 mm", k + 2));
+    let deepest: f64 = o.stderr.split("deepest ").nth(1).unwrap().trim_end().trim_end_matches(" mm)").parse().unwrap();
+    assert!((deepest - 0.1 * nz).abs() <= chord + 1e-6, "deepest {deepest} vs {}", 0.1 * nz);
+}
