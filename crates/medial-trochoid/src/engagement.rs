@@ -266,6 +266,21 @@ impl Cut {
         self.free(&p, self.pieces.len(), &recent)
     }
 
+    /// True if the point `q` is removed: closer than R to one of the pieces (the swept disk
+    /// removes exactly those points).
+    pub fn removes(&self, q: &P2) -> bool {
+        let (kx, ky) = key(self.cell, q);
+        let r = self.radius;
+        (kx - 1..=kx + 1).any(|x| {
+            (ky - 1..=ky + 1).any(|y| {
+                self.grid.get(&(x, y)).is_some_and(|list| {
+                    list.iter()
+                        .any(|&j| boxes_within(&self.boxes[j], &(*q, *q), r) && self.pieces[j].distance_to(q) < r)
+                })
+            })
+        })
+    }
+
     /// Sample positions along every piece: fractions at most `step` mm apart, the piece's end
     /// always included (corners are where engagement peaks). Returns (piece, fraction) pairs.
     pub fn samples(&self, step: f64) -> Vec<(usize, f64)> {
