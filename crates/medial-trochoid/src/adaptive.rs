@@ -12,7 +12,7 @@ use crate::{PlanError, Settings};
 use camkit::contour::region::Region;
 use camkit::contour::{Contour, Seg};
 use camkit::geom::{P2, V2};
-use std::f64::consts::{FRAC_PI_2, PI};
+use std::f64::consts::{FRAC_PI_2, PI, TAU};
 
 /// An adaptive program of one layer and what making it decided.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -33,6 +33,8 @@ pub struct Adaptive {
 /// Heading limits of the walk.
 #[derive(Clone, Copy, Debug)]
 struct Walk {
+    /// Grid of written positions (mm), if rounded.
+    unit: Option<f64>,
     /// Step length (mm).
     step: f64,
     /// Largest turn per step (radians).
@@ -45,72 +47,63 @@ struct Walk {
     wall: f64,
 }
 
+impl Walk {
+    /// `p` on the grid of written positions.
+    fn snap(&self, p: P2) -> P2 {
+        self.unit.map_or(p, |u| P2::new((p.x / u).round() * u, (p.y / u).round() * u))
+    }
+}
+
 /// Engagement (radians) under which a step counts as in air.
 const AIR: f64 = 1e-4;
 
 /// Most entries (helices) in one region.
 const MOST_ENTRIES: usize = 64;
 
+/// Tool circumferences a pass may run without clearing a grid point of material.
+const IDLE_TURNS: f64 = 2.0;
+
 /// Most steps of one pass.
 const MOST_STEPS: usize = 1_000_000;
 
-/// Bisection rounds on a step's heading.
-const BISECTIONS: usize = 14;
+/// How close (radians) under the target a step's engagement is taken as reached.
+const ROOT_TOL: f64 = 0.003;
 
-/// Pieces cut after the indexed ones before the index is built again.
-const REINDEX: usize = 96;
+/// Root-finding rounds on a step's heading.
+const BISECTIONS: usize = 8;
 
-/// The cut so far: an indexed head and a short tail of recent pieces.
+/// The cut so far, indexed piece by piece.
 struct Cutting {
-    r: f64,
-    pieces: Vec<Seg>,
     cut: Cut,
 }
 
 impl Cutting {
     fn new(r: f64) -> Cutting {
-        Cutting { r, pieces: Vec::new(), cut: Cut::new(r, Vec::new()) }
-    }
-
-    fn tail(&self) -> &[Seg] {
-        &self.pieces[self.cut.pieces.len()..]
-    }
-
-    /// Engagement (radians) at the end of `seg` cut after everything so far, or `None` if it
-    /// or the engagement half way is over `limit`.
-    fn after(&self, seg: Seg, limit: f64) -> Option<f64> {
-        let mut extra = self.tail().to_vec();
-        extra.push(seg);
-        let k = extra.len() - 1;
-        let end = self.cut.engagement_after(&extra, k, 1.0);
-        (end <= limit && self.cut.engagement_after(&extra, k, 0.5) <= limit).then_some(end)
+        Cutting { cut: Cut::new(r, Vec::new()) }
     }
 
     /// Largest engagement (radians) along `seg` (at most `h` mm apart, both ends).
     fn along(&self, seg: Seg, h: f64) -> f64 {
-        let mut extra = self.tail().to_vec();
-        extra.push(seg);
         let n = (seg.length() / h).ceil().max(1.0) as usize;
-        (0..=n).map(|k| self.cut.engagement_after(&extra, extra.len() - 1, k as f64 / n as f64)).fold(0.0, f64::max)
+        (0..=n).map(|k| self.cut.engagement_after(&[seg], 0, k as f64 / n as f64)).fold(0.0, f64::max)
     }
 
     /// Engagement (radians) of the tool standing at `p` after everything so far.
     fn standing(&self, p: P2) -> f64 {
-        let mut extra = self.tail().to_vec();
-        extra.push(Seg::Line(p, p));
-        self.cut.engagement_after(&extra, extra.len() - 1, 0.0)
+        self.cut.engagement_at(&p, self.cut.pieces.len())
     }
 
     /// True if the point `q` is removed by what is cut so far.
     fn removes(&self, q: &P2) -> bool {
-        self.cut.removes(q) || self.tail().iter().any(|s| s.distance_to(q) < self.r)
+        self.cut.removes(q)
     }
 
     fn push(&mut self, seg: Seg) {
-        self.pieces.push(seg);
-        if self.tail().len() >= REINDEX {
-            self.cut = Cut::new(self.r, self.pieces.clone());
-        }
+        self.cut.push(seg);
+    }
+
+    fn pop(&mut self) {
+        self.cut.pop();
     }
 }
 
@@ -253,24 +246,32 @@ impl Material {
     }
 
     /// Clears the material within `d` of `seg`.
-    fn clear(&mut self, seg: &Seg, d: f64) {
+    /// Returns how many grid points it cleared.
+    fn clear(&mut self, seg: &Seg, d: f64) -> usize {
         let (a, b) = (seg.start(), seg.end());
         let mid = P2::new(0.5 * (a.x + b.x), 0.5 * (a.y + b.y));
         let reach = d + 0.5 * seg.length();
         let hits = self.each_within(&mid, reach, |k, q| (seg.distance_to(&q) < d).then_some(k));
+        let mut n = 0;
         for k in hits {
             if self.left[k] {
                 self.left[k] = false;
                 self.cleared[k] = true;
+                n += 1;
             }
         }
+        n
     }
 }
 
 /// The adaptive program of `regions` (one layer) at the target `s.threshold`.
-pub fn plan_adaptive(regions: &[Region], s: &Settings) -> Result<Adaptive, PlanError> {
+/// With `unit` (mm), every position of the program is a multiple of it (as the rows are
+/// written to that many decimals), so that the program planned is the one written.
+pub fn plan_adaptive(regions: &[Region], s: &Settings, unit: Option<f64>) -> Result<Adaptive, PlanError> {
     let w = Walk {
-        step: s.sample.min(0.25 * s.radius),
+        unit,
+        // Under the sample spacing, so that each step is one row and one sample.
+        step: 0.99 * s.sample.min(0.25 * s.radius),
         turn: 0.5,
         target: s.threshold.to_radians(),
         r: s.radius,
@@ -291,8 +292,11 @@ pub fn plan_adaptive(regions: &[Region], s: &Settings) -> Result<Adaptive, PlanE
                 .map(|k| (k, m.gap[k]))
                 .max_by(|a, b| a.1.total_cmp(&b.1));
             let Some((k0, cl)) = best else { break };
-            let c0 = m.point(k0);
-            let rh = (0.5 * s.radius).min(cl - w.wall - 1e-6).max(1e-3);
+            let c0 = w.snap(m.point(k0));
+            let rh = w
+                .snap(P2::new((0.5 * s.radius).min(cl - w.wall - 1e-6 - w.unit.unwrap_or(0.0)).max(1e-3), 0.0))
+                .x
+                .max(w.unit.unwrap_or(1e-3));
             let helix = Contour::circle(c0, rh, 0.0, true);
             for (k, seg) in helix.segs().enumerate() {
                 out.program.moves.push(Move { seg, tag: Tag::Entry, retract_before: k == 0 });
@@ -389,6 +393,7 @@ fn walk_pass(
     let mut air = 0.0;
     let mut cut_any = false;
     let mut since_cut = 0usize;
+    let mut idle = 0.0;
     for k in 0..MOST_STEPS {
         let (left, right) = if k == 0 && fresh {
             // From straight away from the material (on the right) to a little into it.
@@ -397,13 +402,22 @@ fn walk_pass(
             (h + w.turn, h - w.turn)
         };
         let Some((theta, e)) = choose(cutting, region, w, p, left, right) else { break };
-        let q = p + V2::new(theta.cos(), theta.sin()) * w.step;
+        let q = w.snap(p + V2::new(theta.cos(), theta.sin()) * w.step);
         let seg = Seg::Line(p, q);
         cutting.push(seg);
-        m.clear(&seg, w.r);
+        if m.clear(&seg, w.r) > 0 {
+            idle = 0.0;
+        } else {
+            idle += w.step;
+        }
         out.push(seg);
         p = q;
         h = theta;
+        // Cutting slivers finer than the grid round and round: the pass ends after a few tool
+        // circumferences without clearing a grid point.
+        if idle >= IDLE_TURNS * TAU * w.r {
+            break;
+        }
         if e <= AIR {
             air += w.step;
             if air >= w.r {
@@ -421,10 +435,7 @@ fn walk_pass(
     let dropped = out.len() - keep;
     out.truncate(keep);
     for _ in 0..dropped {
-        cutting.pieces.pop();
-    }
-    if cutting.pieces.len() < cutting.cut.pieces.len() {
-        cutting.cut = Cut::new(cutting.r, cutting.pieces.clone());
+        cutting.pop();
     }
     (out, cut_any)
 }
@@ -433,32 +444,58 @@ fn walk_pass(
 /// while the step keeps the wall distance and its end's engagement holds the target, with that
 /// engagement (radians); `None` if even `left` does not.
 fn choose(cutting: &Cutting, region: &Region, w: &Walk, p: P2, left: f64, right: f64) -> Option<(f64, f64)> {
-    let eval = |theta: f64| -> Option<f64> {
-        let q = p + V2::new(theta.cos(), theta.sin()) * w.step;
-        let seg = Seg::Line(p, q);
+    let step = |theta: f64| Seg::Line(p, w.snap(p + V2::new(theta.cos(), theta.sin()) * w.step));
+    // The end's engagement less the target (radians); a step that breaks the wall distance
+    // counts as a full turn over.
+    let over = |theta: f64| -> f64 {
+        let seg = step(theta);
         if clearance(&seg, region) < w.wall {
-            return None;
+            return TAU;
         }
-        cutting.after(seg, w.target)
+        cutting.cut.engagement_after(&[seg], 0, 1.0) - w.target
     };
-    if let Some(e) = eval(right) {
-        return Some((right, e));
+    // The step holds the target at its end and half way (the whole-program check samples both).
+    let holds = |theta: f64, f: f64| f <= 0.0 && cutting.cut.engagement_after(&[step(theta)], 0, 0.5) <= w.target;
+    let fr = over(right);
+    if holds(right, fr) {
+        return Some((right, fr + w.target));
     }
     // Where even the leftmost heading does not hold, turning further left (up to a half turn
     // back), the first that does.
     let span = left - right;
-    let mut ok = (1..=8)
-        .map(|k| left + f64::from(k - 1) * (PI - span / 2.0).max(0.0) / 7.0)
-        .find_map(|a| eval(a).map(|e| (a, e)))?;
-    let mut bad = right;
+    let (mut lo, mut flo) =
+        (1..=8).map(|k| left + f64::from(k - 1) * (PI - span / 2.0).max(0.0) / 7.0).find_map(|a| {
+            let f = over(a);
+            holds(a, f).then_some((a, f))
+        })?;
+    // Regula falsi (Illinois) on the end's engagement between `lo` (holds) and `right` (does
+    // not), `lo` kept on the holding side.
+    let (mut hi, mut fhi) = (right, fr);
+    // `wlo`: the holding side's value as weighted by the Illinois rule.
+    let mut wlo = flo;
+    let mut side = 0i8;
     for _ in 0..BISECTIONS {
-        let mid = 0.5 * (ok.0 + bad);
-        match eval(mid) {
-            Some(e) => ok = (mid, e),
-            None => bad = mid,
+        if flo > -ROOT_TOL {
+            break;
+        }
+        let t = if fhi >= 1.0 { 0.5 } else { (wlo / (wlo - fhi)).clamp(0.05, 0.95) };
+        let mid = lo + (hi - lo) * t;
+        let f = over(mid);
+        if holds(mid, f) {
+            (lo, flo, wlo) = (mid, f, f);
+            if side == 1 {
+                fhi *= 0.5;
+            }
+            side = 1;
+        } else {
+            (hi, fhi) = (mid, f.max(1e-12));
+            if side == -1 {
+                wlo *= 0.5;
+            }
+            side = -1;
         }
     }
-    Some(ok)
+    Some((lo, flo + w.target))
 }
 
 /// A cleared tool position next to the material front nearest to `from` (its grid index
@@ -523,6 +560,7 @@ fn front_start(
         });
         let found = around
             .into_iter()
+            .map(|c| w.snap(c))
             .find(|c| region.contains(c) && point_clearance(c, region) >= w.wall && cutting.standing(*c) <= AIR);
         if let Some(c) = found {
             let d = target - c;
@@ -532,4 +570,73 @@ fn front_start(
         given_up.push(m.give_up(k));
     }
     None
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::feed::FeedModel;
+    use crate::medial::MedialOptions;
+    use camkit::geom::arc::angle_of;
+
+    fn settings(r: f64) -> Settings {
+        Settings {
+            radius: r,
+            step: 1.0,
+            threshold: 40.0,
+            trochoid_radius: 0.5 * r,
+            pitch: None,
+            allowance: 0.0,
+            corner_radius: None,
+            sample: 0.5,
+            medial: MedialOptions { resolution: 1e-6, sagitta: 1e-3, chord_error: 1e-3 },
+            feed: FeedModel { spindle: 4800.0, teeth: 6.0, chip: 0.03, fz_max: 0.1, force_at: Some(40.0) },
+        }
+    }
+
+    /// An L-shaped pocket (a 40 × 20 and a 20 × 40 leg) with a square island.
+    fn l_pocket() -> Vec<Region> {
+        let pts = |v: &[(f64, f64)]| v.iter().map(|&(x, y)| P2::new(x, y)).collect::<Vec<_>>();
+        let outer = Contour::polygon(
+            &pts(&[(0.0, 0.0), (40.0, 0.0), (40.0, 20.0), (20.0, 20.0), (20.0, 40.0), (0.0, 40.0)]),
+            true,
+        );
+        let island = Contour::polygon(&pts(&[(6.0, 6.0), (6.0, 10.0), (10.0, 10.0), (10.0, 6.0)]), true);
+        let (regions, _) = camkit::contour::region::regions(&[outer, island]).expect("a region");
+        regions
+    }
+
+    #[test]
+    fn every_cut_holds_the_target_with_the_material_on_the_right() {
+        // The exact engagement of every cutting move's samples (the whole-program check's) is at
+        // most the target, and wherever the tool is in material, the material arcs lie on the
+        // right of travel (climb with a clockwise spindle): their middle within a half turn
+        // clockwise of the heading.
+        let r = 3.0;
+        let s = settings(r);
+        let regions = l_pocket();
+        let plan = plan_adaptive(&regions, &s, None).expect("a plan");
+        let a = crate::analyse(plan.program.clone(), &s, &regions);
+        assert!(a.max_cutting <= 40.0 + crate::ENGAGEMENT_ROUNDOFF_DEG, "{}", a.max_cutting);
+        assert_eq!(a.over + a.over_links, 0);
+        assert!(a.wall_clearance >= r - 1e-9, "{}", a.wall_clearance);
+        let cut = Cut::new(r, plan.program.moves.iter().map(|m| m.seg).collect());
+        let mut checked = 0;
+        for (&(i, t), &e) in a.samples.iter().zip(&a.engagement) {
+            if plan.program.moves[i].tag != Tag::Contour || e < 1.0 {
+                continue;
+            }
+            let heading = angle_of(&plan.program.moves[i].seg.tangent_at(t));
+            for (a0, a1) in cut.material(i, t) {
+                let rel = (0.5 * (a0 + a1) - heading + PI).rem_euclid(TAU) - PI;
+                assert!(rel <= 0.05 && rel > -PI, "move {i}: material at {rel} rad from the heading");
+            }
+            checked += 1;
+        }
+        assert!(checked > 100, "{checked}");
+        // Each pass's steps are short lines (the engagement is held at their ends and middles).
+        assert!(plan.program.moves.iter().filter(|m| m.tag == Tag::Contour).all(|m| m.seg.length() <= s.sample + 1e-9));
+        // What is left is named and smaller than the pocket.
+        assert!(plan.uncut_area < 0.05 * (40.0 * 20.0 + 20.0 * 20.0), "{}", plan.uncut_area);
+    }
 }

@@ -356,7 +356,9 @@ fn run(args: Args) -> Result<()> {
             ..settings
         };
         let layering = (z0, layer_count, layer_depth);
-        return run_adaptive(&args, &regions, &settings, &planning, layering, &name, started);
+        let outer = &sources[regions[0].outer_source];
+        let place = (outer.path, outer.line);
+        return run_adaptive(&args, &regions, &settings, &planning, layering, (&name, place), started);
     }
     let leave_uncut = !(args.no_leave_uncut || args.allow_over_threshold);
     // Planned that much farther from the walls that the written program, rounded to
@@ -623,15 +625,20 @@ fn run_adaptive(
     settings: &Settings,
     planning: &Settings,
     (z0, layer_count, layer_depth): (f64, usize, f64),
-    name: &str,
+    (name, (outer_path, outer_line)): (&str, (i64, u64)),
     started: Instant,
 ) -> Result<()> {
     let r = settings.radius;
     let threshold = settings.threshold;
     let progress = args.io.progress(0, "planning the adaptive passes");
     let planned_at = Instant::now();
-    let plan = medial_trochoid::adaptive::plan_adaptive(regions, planning)
-        .map_err(|e| Error::input(e.to_string()).at(Location::file(name)))?;
+    // The tool fits no region: name the first region's boundary, where the pocket starts.
+    let plan =
+        medial_trochoid::adaptive::plan_adaptive(regions, planning, args.decimals.map(|d| 10f64.powi(-(d as i32))))
+            .map_err(|e| {
+                Error::input(format!("path {outer_path}: {e} (R + allowance = {} mm)", r + settings.allowance))
+                    .at(Location::file(name).line(outer_line))
+            })?;
     let plan_seconds = planned_at.elapsed().as_secs_f64();
     let a = medial_trochoid::analyse(plan.program.clone(), planning, regions);
     let out_table = to_table(&a, z0, layer_count, layer_depth);
