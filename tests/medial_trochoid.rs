@@ -829,7 +829,8 @@ fn moves(csv: &str) -> Vec<(usize, Piece)> {
     let header: Vec<&str> = lines.next().expect("header").split(',').collect();
     let col = |n: &str| header.iter().position(|h| *h == n);
     let (path, mv, x, y) = (col("path").unwrap(), col("move").unwrap(), col("x").unwrap(), col("y").unwrap());
-    let (xc, yc) = (col("xc").unwrap(), col("yc").unwrap());
+    // Tables of lines alone may leave out the arc centre columns.
+    let (xc, yc) = (col("xc"), col("yc"));
     let mut out = Vec::new();
     let mut prev: Option<(String, (f64, f64))> = None;
     for (k, l) in lines.enumerate() {
@@ -840,7 +841,7 @@ fn moves(csv: &str) -> Vec<(usize, Piece)> {
             && v[mv] != "rapid"
         {
             let arc = matches!(v[mv], "cw" | "ccw")
-                .then(|| ((v[xc].parse().unwrap(), v[yc].parse().unwrap()), v[mv] == "ccw"));
+                .then(|| ((v[xc.unwrap()].parse().unwrap(), v[yc.unwrap()].parse().unwrap()), v[mv] == "ccw"));
             out.push((k + 2, Piece { a: *a, b: p, arc }));
         }
         prev = Some((v[path].to_string(), p));

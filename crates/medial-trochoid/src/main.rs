@@ -189,6 +189,10 @@ fn after_help() -> String {
     );
     s.push_str("entry loop of a trochoid run), trochoid, contour or link; each chain starts with a rapid row.\n");
     s.push_str(
+        "--strategy adaptive writes entry (helix), contour (the adaptive passes, straight steps) and link rows;\n",
+    );
+    s.push_str("its report keys: see docs/formats.md (adaptive_minutes, uncut_area_mm2, plan_seconds, ...).\n");
+    s.push_str(
         "Material the tool cannot reach under the threshold is left uncut (see --no-leave-uncut): report keys uncut\n",
     );
     s.push_str(
