@@ -734,6 +734,10 @@ fn a_tool_that_cuts_nothing_under_the_threshold_is_too_large() {
     let refused = w.run(BIN, &[&args[..], &["--no-leave-uncut"]].concat(), b"");
     assert_eq!(refused.status, 1, "{}", refused.stderr);
     assert!(refused.stderr.contains("180.000°"), "{}", refused.stderr);
+    // The adaptive strategy finds no pass that holds the threshold either: the same refusal.
+    w.run(BIN, &[&args[..], &["--strategy", "adaptive"]].concat(), b"")
+        .fails(2, "u-slot.csv:3: path 1: no adaptive pass holds the threshold anywhere: the tool is too large");
+    assert!(!w.path("t.csv").exists());
 }
 
 #[test]

@@ -57,6 +57,9 @@ impl Walk {
 /// Engagement (radians) under which a step counts as in air.
 const AIR: f64 = 1e-4;
 
+/// Smallest helix radius (mm): an entry needs the tool centre this much farther from the walls.
+const ENTRY_ROOM: f64 = 1e-3;
+
 /// Most entries (helices) in one region.
 const MOST_ENTRIES: usize = 64;
 
@@ -287,21 +290,22 @@ pub fn plan_adaptive(regions: &[Region], s: &Settings, unit: Option<f64>) -> Res
     let mut out = Adaptive::default();
     for region in regions {
         let mut m = Material::new(region, &w, h);
+        let unit = w.unit.unwrap_or(0.0);
         let mut given_up: Vec<P2> = Vec::new();
         // An entry where material is left and the tool stands farthest from the walls (the
         // largest inscribed circle at first), a spiral from it, passes along the fronts it
         // leaves; again while material is left that no front reaches under the target.
         for _ in 0..MOST_ENTRIES {
             let best = (0..m.centres.len())
-                .filter(|&k| m.centres[k] && m.left[k])
+                .filter(|&k| m.centres[k] && m.left[k] && m.gap[k] >= w.wall + ENTRY_ROOM + 2.0 * unit)
                 .map(|k| (k, m.gap[k]))
                 .max_by(|a, b| a.1.total_cmp(&b.1));
             let Some((k0, cl)) = best else { break };
             let c0 = w.snap(m.point(k0));
-            let rh = w
-                .snap(P2::new((0.5 * s.radius).min(cl - w.wall - 1e-6 - w.unit.unwrap_or(0.0)).max(1e-3), 0.0))
-                .x
-                .max(w.unit.unwrap_or(1e-3));
+            // The helix keeps the wall distance after its centre is snapped to the written grid
+            // (its radius rounded down onto it).
+            let room = (0.5 * s.radius).min(cl - w.wall - 2.0 * unit);
+            let rh = w.unit.map_or(room, |u| (room / u).floor() * u);
             let helix = Contour::circle(c0, rh, 0.0, true);
             for (k, seg) in helix.segs().enumerate() {
                 out.program.moves.push(Move { seg, tag: Tag::Entry, retract_before: k == 0 });
@@ -316,7 +320,8 @@ pub fn plan_adaptive(regions: &[Region], s: &Settings, unit: Option<f64>) -> Res
         out.uncut.extend(left);
         out.uncut.extend(given_up);
     }
-    if out.program.moves.is_empty() {
+    // Entries alone (no pass holds the target anywhere) are no program: the tool is too large.
+    if out.passes == 0 {
         return Err(PlanError::NoPasses);
     }
     Ok(out)
@@ -364,9 +369,11 @@ fn clear_from(
             return;
         };
         target = Some(t);
+        // A link only through cleared ground: its engagement checked every tenth of a step (the
+        // whole-program check samples it at other places).
         let link = Seg::Line(at, next);
         if link.length() > camkit::tol::POINT_EPS {
-            if clearance(&link, region) >= w.wall && cutting.along(link, w.step) <= AIR {
+            if clearance(&link, region) >= w.wall && cutting.along(link, 0.1 * w.step) <= AIR {
                 out.program.moves.push(Move { seg: link, tag: Tag::Link, retract_before: retract_next });
                 cutting.push(link);
                 retract_next = false;

@@ -636,11 +636,14 @@ fn run_adaptive(
     let threshold = settings.threshold;
     let progress = args.io.progress(0, "planning the adaptive passes");
     let planned_at = Instant::now();
-    // The tool fits no region: name the first region's boundary, where the pocket starts.
+    // No pass holds the target anywhere (or the tool fits nowhere): name the first region's boundary.
     let plan =
         medial_trochoid::adaptive::plan_adaptive(regions, planning, args.decimals.map(|d| 10f64.powi(-(d as i32))))
-            .map_err(|e| {
-                Error::input(format!("path {outer_path}: {e} (R + allowance = {} mm)", r + settings.allowance))
+            .map_err(|_| {
+                Error::input(format!(
+            "path {outer_path}: no adaptive pass holds the threshold anywhere: the tool is too large for the pocket (R + allowance = {} mm)",
+            r + settings.allowance
+        ))
                     .at(Location::file(name).line(outer_line))
             })?;
     let plan_seconds = planned_at.elapsed().as_secs_f64();
