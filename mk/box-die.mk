@@ -20,7 +20,7 @@ BOX_DIE_TROCHOID_RADIUS ?= 2.5
 BOX_DIE_FORCE_AT ?= $(BOX_DIE_THRESHOLD)
 
 .PHONY: demo-box-die
-demo-box-die: $(BOX_DIE)/program.csv $(BOX_DIE)/program.ngc
+demo-box-die: $(BOX_DIE)/program.csv $(BOX_DIE)/program.ngc $(BOX_DIE)/adaptive.ngc
 
 $(BOX_DIE)/program.csv $(BOX_DIE)/report.json $(BOX_DIE)/trochoids.svg $(BOX_DIE)/offset-only.svg &: data/medial-trochoid/box-die.csv $(BOX_DIE_SETUP) $(RELEASE)/medial-trochoid | $(BOX_DIE)/
 	$(RELEASE)/medial-trochoid $< --setup $(BOX_DIE_SETUP) --threshold $(BOX_DIE_THRESHOLD) \
@@ -35,3 +35,15 @@ $(BOX_DIE)/program.csv $(BOX_DIE)/report.json $(BOX_DIE)/trochoids.svg $(BOX_DIE
 $(BOX_DIE)/program.ngc $(BOX_DIE)/program.json $(BOX_DIE)/program.svg &: $(BOX_DIE)/program.csv $(BOX_DIE_SETUP) $(BOX_DIE_MACHINE) $(RELEASE)/post-6axis
 	$(RELEASE)/post-6axis $< --machine $(BOX_DIE_MACHINE) --setup $(BOX_DIE_SETUP) \
 	  --svg $(BOX_DIE)/program.svg --report $(BOX_DIE)/program.json -o $(BOX_DIE)/program.ngc
+
+# Beside the paper's: the adaptive program (--strategy adaptive, the same target, layers, sample,
+# force limit and 4 decimals: passes whose every step holds the engagement at the target by the
+# exact simulation), posted for the same machine with the same links and collision check.
+$(BOX_DIE)/adaptive.csv $(BOX_DIE)/adaptive-report.json $(BOX_DIE)/adaptive-plan.svg &: data/medial-trochoid/box-die.csv $(BOX_DIE_SETUP) $(RELEASE)/medial-trochoid | $(BOX_DIE)/
+	$(RELEASE)/medial-trochoid $< --strategy adaptive --setup $(BOX_DIE_SETUP) --threshold $(BOX_DIE_THRESHOLD) \
+	  --layer-depth $(BOX_DIE_LAYER_DEPTH) --sample $(BOX_DIE_SAMPLE) --force-at $(BOX_DIE_FORCE_AT) --decimals 4 \
+	  --svg $(BOX_DIE)/adaptive-plan.svg --report $(BOX_DIE)/adaptive-report.json -o $(BOX_DIE)/adaptive.csv
+
+$(BOX_DIE)/adaptive.ngc $(BOX_DIE)/adaptive.json $(BOX_DIE)/adaptive.svg &: $(BOX_DIE)/adaptive.csv $(BOX_DIE_SETUP) $(BOX_DIE_MACHINE) $(RELEASE)/post-6axis
+	$(RELEASE)/post-6axis $< --machine $(BOX_DIE_MACHINE) --setup $(BOX_DIE_SETUP) \
+	  --svg $(BOX_DIE)/adaptive.svg --report $(BOX_DIE)/adaptive.json -o $(BOX_DIE)/adaptive.ngc

@@ -8,6 +8,7 @@ pocket is kept in --keep DIR (default /tmp/fuzz-trochoid-kept).
   scripts/fuzz-trochoid.py [SEEDS] [--family star|rect|slot|sharp|all] [--first N] [--jobs J] [--keep DIR]
                           [--minutes M]   (no pocket is started after M minutes; the summary covers those run)
                           [--radii 2,3,5] (the tool radii each pocket runs at)
+                          [--strategy adaptive] (every run with this --strategy)
                                   (binary: $TROCHOID or $CARGO_TARGET_DIR/release/medial-trochoid)
 
 Families: star (stars of lines and arcs, radii 15-24 mm, 0-2 round islands), rect (unions of grid cells, x-monotone,
@@ -33,6 +34,7 @@ from fuzzkit import arc_centre, binary, inside, seg_dist  # noqa: E402
 
 BIN = os.environ.get("TROCHOID", binary("medial-trochoid"))
 CLEAR_TOL, ENG_TOL, ON_LOOP_TOL = 1e-6, 1e-5, 1e-6
+STRATEGY = sys.argv[sys.argv.index("--strategy") + 1] if "--strategy" in sys.argv else None
 
 
 # ---------------------------------------------------------------- geometry of the input loops
@@ -371,6 +373,8 @@ def one(binary, src, loops, run, tmp, tag):
         args += ["--step", f"{step:g}"]
     if layers > 1:
         args += ["--layers", str(layers), "--layer-depth", "5"]
+    if STRATEGY:
+        args += ["--strategy", STRATEGY]
     p = subprocess.run(args, capture_output=True, text=True)
     err = p.stderr.strip().splitlines()
     shown = [a for i, a in enumerate(args[2:]) if a not in ("-o", "--report") and args[2:][i - 1] not in ("-o", "--report")]
@@ -381,7 +385,7 @@ def main():
     argv = sys.argv[1:]
     opt = lambda k, d: argv[argv.index(k) + 1] if k in argv else d
     pos = [a for i, a in enumerate(argv) if not a.startswith("--") and (i == 0 or argv[i - 1] not in
-                                                                         ("--family", "--first", "--jobs", "--keep", "--minutes", "--radii"))]
+                                                                         ("--family", "--first", "--jobs", "--keep", "--minutes", "--radii", "--strategy"))]
     seeds = int(pos[0]) if pos else 40
     fam = opt("--family", "all")
     first = int(opt("--first", "1"))

@@ -734,6 +734,10 @@ fn a_tool_that_cuts_nothing_under_the_threshold_is_too_large() {
     let refused = w.run(BIN, &[&args[..], &["--no-leave-uncut"]].concat(), b"");
     assert_eq!(refused.status, 1, "{}", refused.stderr);
     assert!(refused.stderr.contains("180.000°"), "{}", refused.stderr);
+    // The adaptive strategy finds no pass that holds the threshold either: the same refusal.
+    w.run(BIN, &[&args[..], &["--strategy", "adaptive"]].concat(), b"")
+        .fails(2, "u-slot.csv:3: path 1: no adaptive pass holds the threshold anywhere: the tool is too large");
+    assert!(!w.path("t.csv").exists());
 }
 
 #[test]
@@ -829,7 +833,8 @@ fn moves(csv: &str) -> Vec<(usize, Piece)> {
     let header: Vec<&str> = lines.next().expect("header").split(',').collect();
     let col = |n: &str| header.iter().position(|h| *h == n);
     let (path, mv, x, y) = (col("path").unwrap(), col("move").unwrap(), col("x").unwrap(), col("y").unwrap());
-    let (xc, yc) = (col("xc").unwrap(), col("yc").unwrap());
+    // Tables of lines alone may leave out the arc centre columns.
+    let (xc, yc) = (col("xc"), col("yc"));
     let mut out = Vec::new();
     let mut prev: Option<(String, (f64, f64))> = None;
     for (k, l) in lines.enumerate() {
@@ -840,7 +845,7 @@ fn moves(csv: &str) -> Vec<(usize, Piece)> {
             && v[mv] != "rapid"
         {
             let arc = matches!(v[mv], "cw" | "ccw")
-                .then(|| ((v[xc].parse().unwrap(), v[yc].parse().unwrap()), v[mv] == "ccw"));
+                .then(|| ((v[xc.unwrap()].parse().unwrap(), v[yc.unwrap()].parse().unwrap()), v[mv] == "ccw"));
             out.push((k + 2, Piece { a: *a, b: p, arc }));
         }
         prev = Some((v[path].to_string(), p));
@@ -1040,4 +1045,56 @@ fn extreme_option_values_end_in_time_with_one_line() {
         "--max-memory",
     ];
     w.fuzz_options(BIN, src.to_str().unwrap(), &["--radius", "5", "--sample", "2"], &options, 20, 12);
+}
+
+#[test]
+fn adaptive_programs_hold_the_target_without_gouge_and_the_report_is_the_written_programs() {
+    // `--strategy adaptive` on box-die and the pockets of data/medial-trochoid at the radii the
+    // trochoid tests use: the written program re-simulated by --analyse (the referee) agrees
+    // with the report, holds the target at every sample with its links, keeps R + allowance
+    // from the walls (checked here on the rows, independently), and names what it leaves uncut.
+    let cases: &[(&str, f64, &[&str])] = &[
+        ("box-die.csv", 5.0, &["--sample", "1"]),
+        ("box-die.csv", 5.0, &["--sample", "1", "--decimals", "4"]),
+        ("islands2.csv", 5.0, &["--sample", "1"]),
+        ("lshape.csv", 3.0, &["--sample", "1"]),
+        ("rand003.csv", 4.0, &["--sample", "1"]),
+        ("square.csv", 5.0, &[]),
+        ("island.csv", 5.0, &["--sample", "1", "--allowance", "0.3"]),
+        ("circle15.csv", 3.0, &[]),
+        ("polygon12.csv", 5.0, &[]),
+        ("polygon32.csv", 2.5, &[]),
+        ("star-arcs.csv", 3.0, &["--sample", "1"]),
+        ("dumbbell.csv", 5.0, &["--sample", "1"]),
+        ("circle40.csv", 5.0, &["--sample", "1"]),
+    ];
+    for (file, radius, extra) in cases {
+        let args = [&["--strategy", "adaptive"], *extra].concat();
+        let r = plan_and_analyse(file, *radius, &args);
+        let f = |k: &str| r[k].as_f64().unwrap_or_else(|| panic!("{k} in {r}"));
+        assert_eq!(r["program"], "adaptive");
+        assert!(f("largest_engagement_deg") <= 40.0 + 1e-5, "{file}: {r}");
+        let allowance = if extra.contains(&"--allowance") { 0.3 } else { 0.0 };
+        assert!(f("smallest_wall_clearance_mm") >= radius + allowance - 1e-6, "{file}: {r}");
+        assert!(f("uncut_area_mm2") >= 0.0 && r["uncut_at"].is_array(), "{file}: {r}");
+        assert!(f("adaptive_minutes") > 0.0 && f("adaptive_constant_feed_minutes") >= f("adaptive_minutes"), "{r}");
+        assert!(f("plan_seconds") > 0.0, "{r}");
+    }
+}
+
+#[test]
+fn adaptive_clears_a_round_pocket_in_one_spiral_and_the_default_strategy_is_unchanged() {
+    // A circle of radius 40, R5: one entry at its centre and one spiral pass out to the wall
+    // (no link, nothing left uncut), every sample at or under 40°.
+    let r = plan_and_analyse("circle40.csv", 5.0, &["--strategy", "adaptive", "--sample", "1"]);
+    assert_eq!(r["passes_per_layer"], 1, "{r}");
+    assert_eq!(r["retracts_per_layer"], 1, "{r}");
+    assert_eq!(r["uncut_area_mm2"].as_f64(), Some(0.0), "{r}");
+    // --strategy trochoid is the default: the same bytes with and without it.
+    let w = Work::new();
+    let src = data("medial-trochoid/square.csv");
+    let src = src.to_str().unwrap();
+    w.run(BIN, &[src, "--radius", "5", "-o", "a.csv"], b"").ok();
+    w.run(BIN, &[src, "--radius", "5", "--strategy", "trochoid", "-o", "b.csv"], b"").ok();
+    assert_eq!(w.read("a.csv"), w.read("b.csv"));
 }

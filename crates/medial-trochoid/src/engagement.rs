@@ -141,6 +141,44 @@ impl Cut {
         Cut { radius, pieces, boxes, first, shapes, cell, grid }
     }
 
+    /// Appends `seg`, cut after every piece so far (indexed at once).
+    pub fn push(&mut self, seg: Seg) {
+        let i = self.pieces.len();
+        let b = seg.bounds();
+        let (x0, y0) = key(self.cell, &b.0);
+        let (x1, y1) = key(self.cell, &b.1);
+        for x in x0..=x1 {
+            for y in y0..=y1 {
+                self.grid.entry((x, y)).or_default().push(i);
+            }
+        }
+        self.first.push((x0, y0));
+        self.boxes.push(b);
+        self.shapes.push(Shape::of(&seg));
+        self.pieces.push(seg);
+    }
+
+    /// Removes the last piece (the reverse of [`Cut::push`]).
+    pub fn pop(&mut self) -> Option<Seg> {
+        let seg = self.pieces.pop()?;
+        let i = self.pieces.len();
+        let b = self.boxes.pop().expect("a box per piece");
+        self.first.pop();
+        self.shapes.pop();
+        let (x0, y0) = key(self.cell, &b.0);
+        let (x1, y1) = key(self.cell, &b.1);
+        for x in x0..=x1 {
+            for y in y0..=y1 {
+                if let Some(list) = self.grid.get_mut(&(x, y))
+                    && list.last() == Some(&i)
+                {
+                    list.pop();
+                }
+            }
+        }
+        Some(seg)
+    }
+
     /// The part of the circle at `p` (radians) not removed by pieces `0..before` of `self`
     /// followed by `recent` (cut after them, in order).
     ///
@@ -264,6 +302,21 @@ impl Cut {
             recent.push(extra[k].sub(0.0, t));
         }
         self.free(&p, self.pieces.len(), &recent)
+    }
+
+    /// True if the point `q` is removed: closer than R to one of the pieces (the swept disk
+    /// removes exactly those points).
+    pub fn removes(&self, q: &P2) -> bool {
+        let (kx, ky) = key(self.cell, q);
+        let r = self.radius;
+        (kx - 1..=kx + 1).any(|x| {
+            (ky - 1..=ky + 1).any(|y| {
+                self.grid.get(&(x, y)).is_some_and(|list| {
+                    list.iter()
+                        .any(|&j| boxes_within(&self.boxes[j], &(*q, *q), r) && self.pieces[j].distance_to(q) < r)
+                })
+            })
+        })
     }
 
     /// Sample positions along every piece: fractions at most `step` mm apart, the piece's end

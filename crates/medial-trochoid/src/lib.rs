@@ -11,6 +11,7 @@
 //! [`plan_leaving_uncut`] then plans the regions opened by a radius ([`uncut`]) instead,
 //! leaving uncut, and naming, the material no program reaches under the threshold.
 
+pub mod adaptive;
 pub mod angles;
 pub mod budget;
 pub mod chords;

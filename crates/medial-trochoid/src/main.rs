@@ -29,6 +29,16 @@ enum Which {
     Offset,
 }
 
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+enum Strategy {
+    /// Paper 001: offset passes with trochoids along the medial axis's danger regions first.
+    Trochoid,
+    /// Adaptive clearing: passes whose every step's heading is chosen by the exact engagement
+    /// simulation so that the engagement is the threshold (a helical entry at the largest
+    /// inscribed circle, climb, links through cleared ground).
+    Adaptive,
+}
+
 #[derive(Parser, Debug)]
 #[command(
     name = "medial-trochoid",
@@ -92,6 +102,11 @@ struct Args {
     /// Which program to write.
     #[arg(long, value_enum, default_value_t = Which::Trochoid)]
     program: Which,
+    /// The clearing strategy: the paper's (trochoids first) or adaptive clearing held at the
+    /// threshold by the exact engagement simulation (the written program is the adaptive one;
+    /// --program, --step, --trochoid-radius, --pitch and --corner-radius do not apply).
+    #[arg(long, value_enum, default_value_t = Strategy::Trochoid)]
+    strategy: Strategy,
     /// Write the trochoids-first program even where its re-simulation goes over the threshold
     /// (a warning; the places are listed in the report). Without it that is a failed check:
     /// the report and plots are written, the program is not, exit status 1.
@@ -174,6 +189,10 @@ fn after_help() -> String {
         "Output rows are samples along the tool-centre path (at most --sample mm apart); tag is entry (helical\n",
     );
     s.push_str("entry loop of a trochoid run), trochoid, contour or link; each chain starts with a rapid row.\n");
+    s.push_str(
+        "--strategy adaptive writes entry (helix), contour (the adaptive passes, straight steps) and link rows;\n",
+    );
+    s.push_str("its report keys: see docs/formats.md (adaptive_minutes, uncut_area_mm2, plan_seconds, ...).\n");
     s.push_str(
         "Material the tool cannot reach under the threshold is left uncut (see --no-leave-uncut): report keys uncut\n",
     );
@@ -346,6 +365,17 @@ fn run(args: Args) -> Result<()> {
         ),
         "coarsen --step, --sample, --pitch or --sagitta, use fewer layers",
     )?;
+    if args.strategy == Strategy::Adaptive {
+        let planning = Settings {
+            allowance: settings.allowance + rounding_reach(args.decimals),
+            threshold: planned_threshold,
+            ..settings
+        };
+        let layering = (z0, layer_count, layer_depth);
+        let outer = &sources[regions[0].outer_source];
+        let place = (outer.path, outer.line);
+        return run_adaptive(&args, &regions, &settings, &planning, layering, (&name, place), started);
+    }
     let leave_uncut = !(args.no_leave_uncut || args.allow_over_threshold);
     // Planned that much farther from the walls that the written program, rounded to
     // --decimals, still keeps R + allowance; checked below on the rounded rows.
@@ -598,6 +628,129 @@ fn run(args: Args) -> Result<()> {
     if let Some(over) = failed {
         return Err(Error::check(format!(
             "the trochoids-first program is not written: {over}; --allow-over-threshold writes it anyway"
+        )));
+    }
+    out.commit()
+}
+
+/// The `--strategy adaptive` mode: the adaptive program planned under `planning`, written,
+/// read back and simulated again (the report is the written program's).
+fn run_adaptive(
+    args: &Args,
+    regions: &[Region],
+    settings: &Settings,
+    planning: &Settings,
+    (z0, layer_count, layer_depth): (f64, usize, f64),
+    (name, (outer_path, outer_line)): (&str, (i64, u64)),
+    started: Instant,
+) -> Result<()> {
+    let r = settings.radius;
+    let threshold = settings.threshold;
+    let progress = args.io.progress(0, "planning the adaptive passes");
+    let planned_at = Instant::now();
+    // No pass holds the target anywhere (or the tool fits nowhere): name the first region's boundary.
+    let plan =
+        medial_trochoid::adaptive::plan_adaptive(regions, planning, args.decimals.map(|d| 10f64.powi(-(d as i32))))
+            .map_err(|_| {
+                Error::input(format!(
+            "path {outer_path}: no adaptive pass holds the threshold anywhere: the tool is too large for the pocket (R + allowance = {} mm)",
+            r + settings.allowance
+        ))
+                    .at(Location::file(name).line(outer_line))
+            })?;
+    let plan_seconds = planned_at.elapsed().as_secs_f64();
+    let a = medial_trochoid::analyse(plan.program.clone(), planning, regions);
+    let out_table = to_table(&a, z0, layer_count, layer_depth);
+    let mut text = Vec::new();
+    table::write(&mut text, &out_table, &WriteOptions { decimals: args.decimals })?;
+    progress.stage(0, "simulating the written program again");
+    let written = written_check(&text, name, regions, settings)
+        .map_err(|e| Error::check(format!("the written program does not read back: {e}")))?;
+    progress.finish();
+    let w = &written.analysed;
+    let (over, links_over) = written.over(threshold);
+    let gouge = w.wall_clearance < r + settings.allowance - camkit::tol::OFFSET_TOL;
+    let unreachable = medial_trochoid::uncut::unreachable_area(regions, r + settings.allowance);
+    if plan.uncut_area > 0.0 {
+        cli::warn(&format!(
+            "left uncut: about {:.3} mm² ({} grid points) the passes do not reach under the threshold; named in the report",
+            plan.uncut_area,
+            plan.uncut.len()
+        ));
+    }
+    let mut out = Output::new(args.io.output.as_deref());
+    std::io::Write::write_all(&mut out, &text).map_err(|e| Error::io(e, "output"))?;
+    if let Some(path) = &args.svg {
+        let title = format!(
+            "{name}: adaptive, largest engagement {:.1}° (threshold {threshold}°), {:.2} min per layer",
+            w.max_cutting, w.minutes
+        );
+        write_atomic(path, plot::given_plot(&title, regions, w).to_svg(1000.0).as_bytes())?;
+    }
+    if let Some(path) = &args.io.report {
+        let layers = layer_count as f64;
+        let len = |t: Tag| w.program.length(t) * layers;
+        let mut rep = Report::new("medial-trochoid");
+        rep.set("program", "adaptive")
+            .set("radius_mm", r)
+            .set("threshold_deg", threshold)
+            .set("allowance_mm", settings.allowance)
+            .set("sample_mm", settings.sample)
+            .set("layers", layer_count)
+            .set("layer_depth_mm", layer_depth)
+            .set("first_layer_z", z0)
+            .set("regions", regions.len())
+            .set("islands", regions.iter().map(|g| g.islands.len()).sum::<usize>())
+            .set("passes_per_layer", plan.passes)
+            .set("retracts_per_layer", plan.retracts)
+            .set("largest_engagement_deg", w.max_cutting)
+            .set("link_engagement_deg", w.max_link)
+            .set("entry_engagement_deg", w.max_entry)
+            .set("threshold_held", over + links_over == 0)
+            .set("planned_threshold_deg", planning.threshold)
+            .set("samples_over_threshold", over)
+            .set("link_samples_over_threshold", links_over)
+            .set("samples", w.samples.len())
+            .set("smallest_wall_clearance_mm", w.wall_clearance)
+            .set("no_gouge", !gouge)
+            .set("rounding_reach_mm", rounding_reach(args.decimals))
+            .set("adaptive_minutes", w.minutes * layers)
+            .set("adaptive_constant_feed_minutes", w.minutes_constant * layers)
+            .set("adaptive_chip_only_minutes", w.minutes_chip_only * layers)
+            .set("adaptive_constant_feed_chip_only_minutes", w.minutes_constant_chip_only * layers)
+            .set("force_limit_at_deg", settings.feed.force_at)
+            .set("length_mm", w.program.moves.iter().map(|m| m.seg.length()).sum::<f64>() * layers)
+            .set("contour_length_mm", len(Tag::Contour))
+            .set("link_length_mm", len(Tag::Link))
+            .set("entry_length_mm", len(Tag::Entry))
+            .set("contour_feed_mm_min", s_feed(w, Tag::Contour))
+            .set("uncut_area_mm2", plan.uncut_area)
+            .set("uncut_points", plan.uncut.len())
+            .set(
+                "uncut_at",
+                plan.uncut
+                    .iter()
+                    .step_by(plan.uncut.len().div_ceil(50).max(1))
+                    .map(|p| vec![p.x, p.y])
+                    .collect::<Vec<_>>(),
+            )
+            .set("unreachable_area_mm2", unreachable)
+            .set("output_rows", out_table.rows.len())
+            .set("plan_seconds", plan_seconds)
+            .set("seconds", started.elapsed().as_secs_f64());
+        rep.write(path)?;
+    }
+    if gouge {
+        return Err(Error::check(format!(
+            "the program is not written: the program as written comes {:.6} mm from the walls, under R + allowance = {} mm",
+            w.wall_clearance,
+            r + settings.allowance
+        )));
+    }
+    if over + links_over > 0 && !args.allow_over_threshold {
+        return Err(Error::check(format!(
+            "the adaptive program is not written: as written it has {over} cutting and {links_over} link samples over the threshold (largest {:.3}° cutting, {:.3}° on links); --allow-over-threshold writes it anyway",
+            w.max_cutting, w.max_link
         )));
     }
     out.commit()
