@@ -506,18 +506,13 @@ fn run(args: Args) -> Result<()> {
         let layers = layer_count as f64;
         let (a, b) = (&plan.offset_only, &plan.trochoidal);
         let medial_edges: usize = plan.medial.iter().map(|m| m.edges.len()).sum();
-        let mut rep = Report::new("medial-trochoid");
-        rep.set("program", if troch_main { "trochoid" } else { "offset" })
-            .set("radius_mm", r)
-            .set("step_mm", step)
-            .set("threshold_deg", threshold)
-            .set("allowance_mm", args.allowance)
-            .set("sample_mm", settings.sample)
-            .set("layers", layer_count)
-            .set("layer_depth_mm", layer_depth)
-            .set("first_layer_z", z0)
-            .set("regions", regions.len())
-            .set("islands", regions.iter().map(|g| g.islands.len()).sum::<usize>())
+        let mut rep = pocket_report(
+            if troch_main { "trochoid" } else { "offset" },
+            &settings,
+            (z0, layer_count, layer_depth),
+            &regions,
+        );
+        rep.set("step_mm", step)
             .set("passes_per_layer", plan.passes.len())
             .set("voronoi_segments", plan.medial.iter().map(|m| m.segments).sum::<usize>())
             .set("voronoi_resolution_mm", settings.medial.resolution)
@@ -633,6 +628,28 @@ fn run(args: Args) -> Result<()> {
     out.commit()
 }
 
+/// The report keys both strategies share: the program, the tool and threshold, the layers and
+/// the pocket's regions.
+fn pocket_report(
+    program: &str,
+    settings: &Settings,
+    (z0, layers, depth): (f64, usize, f64),
+    regions: &[Region],
+) -> Report {
+    let mut rep = Report::new("medial-trochoid");
+    rep.set("program", program)
+        .set("radius_mm", settings.radius)
+        .set("threshold_deg", settings.threshold)
+        .set("allowance_mm", settings.allowance)
+        .set("sample_mm", settings.sample)
+        .set("layers", layers)
+        .set("layer_depth_mm", depth)
+        .set("first_layer_z", z0)
+        .set("regions", regions.len())
+        .set("islands", regions.iter().map(|g| g.islands.len()).sum::<usize>());
+    rep
+}
+
 /// The `--strategy adaptive` mode: the adaptive program planned under `planning`, written,
 /// read back and simulated again (the report is the written program's).
 fn run_adaptive(
@@ -690,18 +707,8 @@ fn run_adaptive(
     if let Some(path) = &args.io.report {
         let layers = layer_count as f64;
         let len = |t: Tag| w.program.length(t) * layers;
-        let mut rep = Report::new("medial-trochoid");
-        rep.set("program", "adaptive")
-            .set("radius_mm", r)
-            .set("threshold_deg", threshold)
-            .set("allowance_mm", settings.allowance)
-            .set("sample_mm", settings.sample)
-            .set("layers", layer_count)
-            .set("layer_depth_mm", layer_depth)
-            .set("first_layer_z", z0)
-            .set("regions", regions.len())
-            .set("islands", regions.iter().map(|g| g.islands.len()).sum::<usize>())
-            .set("passes_per_layer", plan.passes)
+        let mut rep = pocket_report("adaptive", settings, (z0, layer_count, layer_depth), regions);
+        rep.set("passes_per_layer", plan.passes)
             .set("retracts_per_layer", plan.retracts)
             .set("largest_engagement_deg", w.max_cutting)
             .set("link_engagement_deg", w.max_link)
