@@ -23,7 +23,39 @@ const SURFACES: &str =
     "PLANE, CYLINDRICAL_SURFACE, CONICAL_SURFACE, SPHERICAL_SURFACE, TOROIDAL_SURFACE, B_SPLINE_SURFACE_WITH_KNOTS";
 
 /// The edge curve entities read.
-const CURVES: &str = "LINE, CIRCLE, B_SPLINE_CURVE_WITH_KNOTS (also as SURFACE_CURVE or SEAM_CURVE)";
+const CURVES: &str = "LINE, CIRCLE, ELLIPSE, B_SPLINE_CURVE_WITH_KNOTS (also as SURFACE_CURVE or SEAM_CURVE)";
+
+/// Parameter length of the ellipse spline of [`ellipse_from`]: four quarter arcs.
+const ELLIPSE_DOMAIN: f64 = 4.0;
+
+/// The ellipse `centre + x cos θ + y sin θ` (`x`, `y` its semi-axes as vectors) as an exact
+/// rational quadratic spline of four quarter arcs (the affine image of the NURBS circle), starting
+/// at `start` (a point of it) and running the way θ grows, over [0, [`ELLIPSE_DOMAIN`]].
+fn ellipse_from(centre: P3, x: V3, y: V3, start: P3) -> SplineCurve {
+    let d = start - centre;
+    let t = (d.dot(&y) / y.norm_squared()).atan2(d.dot(&x) / x.norm_squared());
+    let (c, s) = (t.cos(), t.sin());
+    // The unit circle's nine control points turned by θ = t, then mapped onto the ellipse.
+    let unit = [
+        (1.0, 0.0),
+        (1.0, 1.0),
+        (0.0, 1.0),
+        (-1.0, 1.0),
+        (-1.0, 0.0),
+        (-1.0, -1.0),
+        (0.0, -1.0),
+        (1.0, -1.0),
+        (1.0, 0.0),
+    ];
+    let ctrl = unit.iter().map(|&(u, v)| centre + x * (u * c - v * s) + y * (u * s + v * c)).collect();
+    let w = std::f64::consts::FRAC_1_SQRT_2;
+    SplineCurve {
+        degree: 2,
+        ctrl,
+        weights: Some(vec![1.0, w, 1.0, w, 1.0, w, 1.0, w, 1.0]),
+        knots: vec![0.0, 0.0, 0.0, 1.0, 1.0, 2.0, 2.0, 3.0, 3.0, 4.0, 4.0, 4.0],
+    }
+}
 
 /// Why a face could not be read.
 enum Problem {
@@ -385,6 +417,20 @@ impl Reader<'_> {
                 }
                 Ok(Curve::Arc { centre, x, y, radius, t0, t1 })
             }
+            (1, "ELLIPSE") => {
+                let p = &c.parts[0].1;
+                let iso = self.axis2(self.reference(cid, p, 1)?)?;
+                let (ra, rb) = (self.length(cid, p, 2)?, self.length(cid, p, 3)?);
+                let centre = to_local(iso * P3::origin());
+                let (x, y) = (vec_local(iso * V3::x()) * ra, vec_local(iso * V3::y()) * rb);
+                let curve = ellipse_from(centre, x, y, a);
+                let t1 = if (a - b).norm() <= 1e-9 * (1.0 + a.coords.norm()) {
+                    ELLIPSE_DOMAIN // a closed edge: the whole ellipse
+                } else {
+                    curve.nearest(&b, 0.0, ELLIPSE_DOMAIN).0
+                };
+                Ok(Curve::Spline { curve, t0: 0.0, t1 })
+            }
             _ if c.part("B_SPLINE_CURVE_WITH_KNOTS").is_some() => {
                 let mut curve = self.bspline_curve(cid)?;
                 curve.ctrl = curve.ctrl.into_iter().map(to_local).collect();
@@ -620,5 +666,57 @@ mod tests {
         assert_eq!(m.surfaces.len(), 1);
         let e = load(&step("#1 = CARTESIAN_POINT('',(0.,0.,0.));\n"), false).unwrap_err();
         assert!(e.to_string().starts_with("t.stp: no surfaces"), "{e}");
+    }
+
+    /// A plane face bounded by a half ellipse (semi-axes 10 and 5) and its major axis: the upper
+    /// half, or the lower half whose arc crosses the ellipse's own start; and the whole ellipse.
+    fn ellipse_face(from: usize, to: usize, closed: bool) -> String {
+        let mut s = String::from(
+            "#1 = CARTESIAN_POINT('',(0.,0.,0.));\n#2 = DIRECTION('',(0.,0.,1.));\n#3 = DIRECTION('',(1.,0.,0.));\n\
+             #4 = AXIS2_PLACEMENT_3D('',#1,#2,#3);\n#5 = PLANE('',#4);\n#10 = CARTESIAN_POINT('',(10.,0.,0.));\n\
+             #11 = CARTESIAN_POINT('',(-10.,0.,0.));\n#20 = VERTEX_POINT('',#10);\n#21 = VERTEX_POINT('',#11);\n\
+             #50 = ELLIPSE('',#4,10.,5.);\n#99 = VECTOR('',#3,1.);\n#51 = LINE('',#11,#99);\n",
+        );
+        if closed {
+            s += "#30 = EDGE_CURVE('',#20,#20,#50,.T.);\n#40 = ORIENTED_EDGE('',*,*,#30,.T.);\n#60 = EDGE_LOOP('',(#40));\n";
+        } else {
+            s += &format!(
+                "#30 = EDGE_CURVE('',#{from},#{to},#50,.T.);\n#31 = EDGE_CURVE('',#{to},#{from},#51,.T.);\n\
+                 #40 = ORIENTED_EDGE('',*,*,#30,.T.);\n#41 = ORIENTED_EDGE('',*,*,#31,.T.);\n#60 = EDGE_LOOP('',(#40,#41));\n"
+            );
+        }
+        s + "#61 = FACE_OUTER_BOUND('',#60,.T.);\n#62 = ADVANCED_FACE('',(#61),#5,.T.);\n\
+             #70 = ( LENGTH_UNIT() NAMED_UNIT(*) SI_UNIT(.MILLI.,.METRE.) );\n"
+    }
+
+    #[test]
+    fn ellipse_edges_bound_faces_exactly() {
+        // The nearest point of the ellipse by brute force: the true one is no farther.
+        let on_ellipse = |q: &P3| {
+            (0..200_000)
+                .map(|k| {
+                    let t = TAU * k as f64 / 200_000.0;
+                    (P3::new(10.0 * t.cos(), 5.0 * t.sin(), 0.0) - q).norm()
+                })
+                .fold(f64::INFINITY, f64::min)
+        };
+        let upper = load(&step(&ellipse_face(20, 21, false)), false).unwrap();
+        let lower = load(&step(&ellipse_face(21, 20, false)), false).unwrap();
+        let whole = load(&step(&ellipse_face(20, 20, true)), false).unwrap();
+        let near = |m: &Model, q: P3| m.nearest(&q).point;
+        assert!((near(&upper, P3::new(6.0, 2.0, 1.0)) - P3::new(6.0, 2.0, 0.0)).norm() < 1e-12);
+        assert!((near(&upper, P3::new(6.0, -2.0, 1.0)) - P3::new(6.0, 0.0, 0.0)).norm() < 1e-9);
+        assert!((near(&upper, P3::new(0.0, 8.0, 1.0)) - P3::new(0.0, 5.0, 0.0)).norm() < 1e-7);
+        assert!((near(&lower, P3::new(6.0, -2.0, 1.0)) - P3::new(6.0, -2.0, 0.0)).norm() < 1e-12);
+        assert!((near(&lower, P3::new(6.0, 2.0, 1.0)) - P3::new(6.0, 0.0, 0.0)).norm() < 1e-9);
+        assert!((near(&lower, P3::new(0.0, -8.0, 1.0)) - P3::new(0.0, -5.0, 0.0)).norm() < 1e-7);
+        for q in [P3::new(12.0, 7.0, 0.5), P3::new(-11.0, -3.0, 2.0), P3::new(3.0, -9.0, -1.0), P3::new(10.5, 0.2, 0.0)]
+        {
+            let n = whole.nearest(&q);
+            let p = n.point;
+            assert!(((p.x / 10.0).powi(2) + (p.y / 5.0).powi(2) - 1.0).abs() < 1e-9 && p.z.abs() < 1e-12, "{p}");
+            assert!(n.distance <= on_ellipse(&q) + 1e-9, "{q}: {} against {}", n.distance, on_ellipse(&q));
+        }
+        assert!((near(&whole, P3::new(-4.0, 3.0, 2.0)) - P3::new(-4.0, 3.0, 0.0)).norm() < 1e-12);
     }
 }
