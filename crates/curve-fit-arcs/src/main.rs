@@ -190,12 +190,8 @@ fn run(args: Args) -> Result<()> {
     } else {
         let (t, skipped) = camkit::contour::load::table(&input, &contour_opts)?;
         warn_skipped(&input.name, &skipped);
-        let distinct = t.rows.windows(2).filter(|w| (w[0].pos - w[1].pos).norm() > camkit::tol::POINT_EPS).count() + 1;
-        if t.rows.is_empty() || distinct < 2 {
-            let what = if t.rows.is_empty() { "no points" } else { "a single point" };
-            return Err(Error::input(format!("{what}: at least two distinct points are needed"))
-                .at(Location::file(&input.name)));
-        }
+        let moved = t.rows.windows(2).any(|w| moves(&w[0].pos, &w[1].pos));
+        two_points(&input.name, t.rows.len(), moved)?;
         let d = args.decimals.unwrap_or(4);
         let (fitted, stats, runs) = table_runs::fit_table(&t, &opts, Some(d))
             .map_err(|e| unfittable(&input.name, e.line, e.cause.deviation, &opts))?;
@@ -220,26 +216,24 @@ fn run_table(args: &Args, opts: &Options, contours: &camkit::contour::load::Opti
     let keep_runs = args.svg.is_some() || args.lower_bound;
     let wopts = WriteOptions { decimals: args.decimals };
     let mut guess = Written { arcs: true, other_planes: false };
-    for pass in 0.. {
+    let mut warned = false;
+    loop {
         let mut fitter = Fitter::new(opts, args.decimals, keep_runs);
         let mut writer: Option<table::RowWriter> = None;
         let (mut rows, mut moved, mut last) = (0usize, false, None::<camkit::geom::P3>);
         let (schema, skipped) = camkit::contour::load::table_each(&input, contours, |schema, row| {
             rows += 1;
-            moved |= last.is_some_and(|p| (p - row.pos).norm() > camkit::tol::POINT_EPS);
+            moved |= last.is_some_and(|p| moves(&p, &row.pos));
             last = Some(row.pos);
             fitter.push(row).map_err(|e| unfittable(&input.name, e.line, e.cause.deviation, opts))?;
             let w = writer.get_or_insert_with(|| table::RowWriter::new(&guess.schema(schema), wopts));
             fitter.ready.drain(..).try_for_each(|r| w.row(&mut out, &r))
         })?;
-        if pass == 0 {
+        if !warned {
             warn_skipped(&input.name, &skipped);
+            warned = true;
         }
-        if !moved {
-            let what = if rows == 0 { "no points" } else { "a single point" };
-            return Err(Error::input(format!("{what}: at least two distinct points are needed"))
-                .at(Location::file(&input.name)));
-        }
+        two_points(&input.name, rows, moved)?;
         fitter.flush().map_err(|e| unfittable(&input.name, e.line, e.cause.deviation, opts))?;
         let mut w = writer.expect("rows were read");
         fitter.ready.drain(..).try_for_each(|r| w.row(&mut out, &r))?;
@@ -254,7 +248,20 @@ fn run_table(args: &Args, opts: &Options, contours: &camkit::contour::load::Opti
         finish(args, opts, &input.name, &stats, &runs, started, input.data.len(), out.len() as usize)?;
         return out.commit();
     }
-    unreachable!("the second pass writes the header the first one found")
+}
+
+/// True when two consecutive input points are distinct.
+fn moves(a: &camkit::geom::P3, b: &camkit::geom::P3) -> bool {
+    (a - b).norm() > camkit::tol::POINT_EPS
+}
+
+/// Refuses input of `rows` points that never `moved`: a fit needs two distinct points.
+fn two_points(name: &str, rows: usize, moved: bool) -> Result<()> {
+    if moved {
+        return Ok(());
+    }
+    let what = if rows == 0 { "no points" } else { "a single point" };
+    Err(Error::input(format!("{what}: at least two distinct points are needed")).at(Location::file(name)))
 }
 
 /// Warns of a drawing's entities that are not contours.

@@ -333,7 +333,11 @@ fn run_fixed(args: &Args, tool: &Tool, tool_file: &str, axis: V3, started: Insta
     table::read_each(&input, &[Col::X, Col::Y, Col::Z], |schema, row| {
         let s = match &mut stream {
             Some(s) => s,
-            None => stream.insert(FixedStream::new(schema, part.is_some(), args.decimals)),
+            None => stream.insert(FixedStream::new(
+                schema,
+                Tips { axis, r, part: part.as_ref(), gouge_tol: args.gouge_tol },
+                args.decimals,
+            )),
         };
         s.check.row(&row, &input.name)?;
         if placed.rows == 0 {
@@ -348,7 +352,7 @@ fn run_fixed(args: &Args, tool: &Tool, tool_file: &str, axis: V3, started: Insta
         placed.rows += 1;
         chunk.push(row);
         if chunk.len() == CHUNK {
-            s.place(&mut chunk, &axis, r, part.as_ref(), args.gouge_tol, &mut placed, &mut out)?;
+            s.place(&mut chunk, &mut placed, &mut out)?;
             progress.inc(CHUNK as u64);
         }
         Ok(())
@@ -356,7 +360,7 @@ fn run_fixed(args: &Args, tool: &Tool, tool_file: &str, axis: V3, started: Insta
     let Some(mut s) = stream else {
         return Err(Error::input("no rows").at(Location::file(&input.name)));
     };
-    s.place(&mut chunk, &axis, r, part.as_ref(), args.gouge_tol, &mut placed, &mut out)?;
+    s.place(&mut chunk, &mut placed, &mut out)?;
     s.writer.finish(&mut out)?;
     progress.finish();
     let mut report = Report::new("tool-attitude");
@@ -390,8 +394,19 @@ fn run_fixed(args: &Args, tool: &Tool, tool_file: &str, axis: V3, started: Insta
 /// Rows placed at a time by the fixed-axis stream (in parallel within a chunk).
 const CHUNK: usize = 1 << 14;
 
+/// How the fixed-axis stream places a tip: the axis, the ball's radius, the part checked for
+/// gouges (if any) and the gouge tolerance.
+#[derive(Clone, Copy)]
+struct Tips<'p> {
+    axis: V3,
+    r: f64,
+    part: Option<&'p Part>,
+    gouge_tol: f64,
+}
+
 /// The fixed-axis stream's output: the meaning check, the columns added and the writer.
-struct FixedStream {
+struct FixedStream<'p> {
+    tips: Tips<'p>,
     check: meaning::Check,
     gouge: Option<usize>,
     marker: meaning::TipMarker,
@@ -411,43 +426,34 @@ struct Placed {
     kept: Option<Vec<table::Row>>,
 }
 
-impl FixedStream {
-    fn new(schema: &table::Schema, gouge: bool, decimals: Option<u32>) -> FixedStream {
+impl<'p> FixedStream<'p> {
+    fn new(schema: &table::Schema, tips: Tips<'p>, decimals: Option<u32>) -> FixedStream<'p> {
         let mut out = schema.clone();
         out.add(&[Col::I, Col::J, Col::K]);
-        let gouge = gouge.then(|| out.add_extra("gouge"));
+        let gouge = tips.part.is_some().then(|| out.add_extra("gouge"));
         let marker = meaning::TipMarker::new(&out);
         let writer = table::RowWriter::new(&marker.schema, WriteOptions { decimals });
-        FixedStream { check: meaning::Check::new(schema), gouge, marker, writer }
+        FixedStream { tips, check: meaning::Check::new(schema), gouge, marker, writer }
     }
 
     /// Places the rows of `chunk` (emptied): tips and, with a part, their gouges (in parallel),
     /// then writes them in order.
-    #[allow(clippy::too_many_arguments)]
-    fn place(
-        &mut self,
-        chunk: &mut Vec<table::Row>,
-        axis: &V3,
-        r: f64,
-        part: Option<&Part>,
-        gouge_tol: f64,
-        placed: &mut Placed,
-        out: &mut Stream,
-    ) -> Result<()> {
-        let gouges: Vec<f64> = chunk
+    fn place(&mut self, chunk: &mut Vec<table::Row>, placed: &mut Placed, out: &mut Stream) -> Result<()> {
+        let Tips { axis, r, part, gouge_tol } = self.tips;
+        let placed_tips: Vec<(P3, f64)> = chunk
             .par_iter()
             .map(|row| {
-                let tip = tool_attitude::fixed_axis_ball_tip(&row.pos, axis, r);
-                part.map_or(0.0, |p| p.penetration(&tool_attitude::pose::Pose { tip, axis: *axis, edge: None }))
+                let tip = tool_attitude::fixed_axis_ball_tip(&row.pos, &axis, r);
+                (tip, part.map_or(0.0, |p| p.penetration(&tool_attitude::pose::Pose { tip, axis, edge: None })))
             })
             .collect();
-        for (mut row, g) in chunk.drain(..).zip(gouges) {
+        for (mut row, (tip, g)) in chunk.drain(..).zip(placed_tips) {
             if placed.last_path != Some(row.path) {
                 placed.paths += 1;
                 placed.last_path = Some(row.path);
             }
-            row.pos = tool_attitude::fixed_axis_ball_tip(&row.pos, axis, r);
-            row.axis = *axis;
+            row.pos = tip;
+            row.axis = axis;
             if let Some(i) = self.gouge {
                 row.extra.resize(i + 1, String::new());
                 row.extra[i] = num(g);
