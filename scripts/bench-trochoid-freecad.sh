@@ -61,5 +61,9 @@ fc, ad, ada = (json.load(open(f)) for f in sys.argv[3:6])
 print(f"{p} | {fc['largest_engagement_deg']:.1f}°, {fc['length_mm']:.0f} mm, {fc['minutes']:.2f} / {fc['constant_feed_minutes']:.2f} min, {fcsec:.2f} s, gouge-free {fc['no_gouge']}"
       f" | {ada['largest_engagement_deg']:.4f}°, {ada['length_mm']:.0f} mm ({ad['link_length_mm']:.0f}), {ada['minutes']:.2f} / {ada['constant_feed_minutes']:.2f} min, {ad['plan_seconds']:.2f} s, gouge-free {ada['no_gouge']}, uncut {ad['uncut_area_mm2']:.1f} mm²"
       f" | {ada['minutes'] / fc['minutes']:.2f}x / {ada['constant_feed_minutes'] / fc['constant_feed_minutes']:.2f}x, plan {ad['plan_seconds'] / fcsec:.2f}x")
+# Where the time goes (feed following; minutes / mm per kind; retracts: count / mm, not timed).
+kinds = lambda t: ", ".join(f"{k} {v['minutes']:.2f} min / {v['mm']:.0f} mm" if 'minutes' in v else f"{k} {v['count']:.0f} / {v['mm']:.0f} mm" for k, v in t.items())
+print(f"  FreeCAD by kind: {kinds(fc['time_by_kind'])}; chains {fc['chains']}, air above the layer {fc['air_length_mm']:.0f} mm")
+print(f"  ours by kind:    {kinds(ada['time_by_kind'])}")
 PY
 done
