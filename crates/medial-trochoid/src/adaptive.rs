@@ -48,10 +48,10 @@ struct Walk {
 }
 
 impl Walk {
-    /// Spacing (mm) of a link's engagement checks: between two tool circles d apart in cleared
-    /// ground, a circle in between meets material only within asin(d/4R) of the travel's normal
-    /// on each side, at most 4·asin(d/4R) in all; at 2R·sin(target/8) that is under half the
-    /// target (and never over a step: the walk's own spacing).
+    /// Spacing (mm) of a link's engagement checks: with the disks at two checks d apart
+    /// cleared, a circle a and b from them (a + b = d) meets material only outside both, within
+    /// asin(a/2R) + asin(b/2R) ≤ asin(d/2R) on each side of the travel; at d = 2R·sin(target/8)
+    /// that is a quarter of the target in all (and never over a step: the walk's own spacing).
     fn link_spacing(&self) -> f64 {
         self.step.min(2.0 * self.r * (0.125 * self.target).sin())
     }
