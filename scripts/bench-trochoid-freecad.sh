@@ -41,9 +41,10 @@ done
 # Adaptive strategy (issue 22) against FreeCAD's adaptive at 11.82 % on box-die and three more
 # pockets (islands, a narrow neck, a round one): FreeCAD's program analysed first (its largest
 # engagement is the bound for our target), then ours planned on one core (RAYON_NUM_THREADS=1,
-# the plan's own time in plan_seconds) at the target ADAPTIVE_TARGET (default 40°) and analysed
+# the plan's own time in plan_seconds) at each target of ADAPTIVE_TARGETS (default "40 freecad":
+# 40° and FreeCAD's largest engagement on that pocket rounded down to the degree) and analysed
 # by the same referee; all at the same feed model (force limit of the 40° side cut, --force-at 40).
-TARGET_DEG=${ADAPTIVE_TARGET:-40}
+TARGETS=${ADAPTIVE_TARGETS:-40 freecad}
 echo "pocket | FreeCAD: largest, length, min (feed following / one feed per kind), Execute s | ours adaptive: largest, length (links), min (feed following / one feed per kind), plan s | ratios"
 for spec in "box-die 0 0 100 100 60" "islands2 0 0 100 60 10" "dumbbell 0 0 94 40 10" "circle40 10 10 90 90 10"; do
   set -- $spec
@@ -52,14 +53,22 @@ for spec in "box-die 0 0 100 100 60" "islands2 0 0 100 60 10" "dumbbell 0 0 94 4
   fcout=$(python3 scripts/freecad-adaptive.py "$SRCP" "$tmp/fc-$P.csv" --diameter 10 --stepover 11.82 --stock "$2" "$3" "$4" "$5" --top "$6")
   fcsec=$(echo "$fcout" | sed -n 's/.*seconds \([0-9.]*\).*/\1/p')
   "$B" "$SRCP" "${COMMON[@]}" --threshold 40 --force-at 40 --analyse "$tmp/fc-$P.csv" --report "$tmp/fc-$P.json" -o /dev/null
+  for TARGET_DEG in $TARGETS; do
+  # "freecad": FreeCAD's measured largest engagement rounded down to the degree (the issue's bound).
+  [ "$TARGET_DEG" = freecad ] && TARGET_DEG=$(python3 -c "import json,sys,math; print(math.floor(json.load(open(sys.argv[1]))['largest_engagement_deg']))" "$tmp/fc-$P.json")
   RAYON_NUM_THREADS=1 "$B" "$SRCP" "${COMMON[@]}" --strategy adaptive --threshold "$TARGET_DEG" --force-at 40 --report "$tmp/ad-$P.json" -o "$tmp/ad-$P.csv" 2>/dev/null
   "$B" "$SRCP" "${COMMON[@]}" --threshold "$TARGET_DEG" --force-at 40 --analyse "$tmp/ad-$P.csv" --report "$tmp/ada-$P.json" -o /dev/null
-  python3 - "$P" "$fcsec" "$tmp/fc-$P.json" "$tmp/ad-$P.json" "$tmp/ada-$P.json" <<'PY'
+  python3 - "$P@$TARGET_DEG°" "$fcsec" "$tmp/fc-$P.json" "$tmp/ad-$P.json" "$tmp/ada-$P.json" <<'PY'
 import json, sys
 p, fcsec = sys.argv[1], float(sys.argv[2])
 fc, ad, ada = (json.load(open(f)) for f in sys.argv[3:6])
 print(f"{p} | {fc['largest_engagement_deg']:.1f}°, {fc['length_mm']:.0f} mm, {fc['minutes']:.2f} / {fc['constant_feed_minutes']:.2f} min, {fcsec:.2f} s, gouge-free {fc['no_gouge']}"
       f" | {ada['largest_engagement_deg']:.4f}°, {ada['length_mm']:.0f} mm ({ad['link_length_mm']:.0f}), {ada['minutes']:.2f} / {ada['constant_feed_minutes']:.2f} min, {ad['plan_seconds']:.2f} s, gouge-free {ada['no_gouge']}, uncut {ad['uncut_area_mm2']:.1f} mm²"
       f" | {ada['minutes'] / fc['minutes']:.2f}x / {ada['constant_feed_minutes'] / fc['constant_feed_minutes']:.2f}x, plan {ad['plan_seconds'] / fcsec:.2f}x")
+# Where the time goes (feed following; minutes / mm per kind; retracts: count / mm, not timed).
+kinds = lambda t: ", ".join(f"{k} {v['minutes']:.2f} min / {v['mm']:.0f} mm" if 'minutes' in v else f"{k} {v['count']:.0f} / {v['mm']:.0f} mm" for k, v in t.items())
+print(f"  FreeCAD by kind: {kinds(fc['time_by_kind'])}; chains {fc['chains']}, air above the layer {fc['air_length_mm']:.0f} mm")
+print(f"  ours by kind:    {kinds(ada['time_by_kind'])}")
 PY
+  done
 done

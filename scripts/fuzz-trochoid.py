@@ -9,12 +9,13 @@ pocket is kept in --keep DIR (default /tmp/fuzz-trochoid-kept).
                           [--minutes M]   (no pocket is started after M minutes; the summary covers those run)
                           [--radii 2,3,5] (the tool radii each pocket runs at)
                           [--strategy adaptive] (every run with this --strategy)
+                          [--thresholds 40,30] (the thresholds a run picks from at random)
                                   (binary: $TROCHOID or $CARGO_TARGET_DIR/release/medial-trochoid)
 
 Families: star (stars of lines and arcs, radii 15-24 mm, 0-2 round islands), rect (unions of grid cells, x-monotone,
 some with a rectangular island), slot (thin L and U slots, straight or round ends, width 2R x
 0.9-1.4 for an R of the runs), sharp (polygons with spikes of 4-25 degree inside corners).
-Settings: R 2, 3, 5 or --radii (each pocket runs every R once with a random threshold 40/30, step default or
+Settings: R 2, 3, 5 or --radii (each pocket runs every R once with a random threshold 40/30 (or --thresholds), step default or
 0.6 R, allowance 0 or 0.3) and one run with --layers 2 --layer-depth 5.
 Checks of each exit-0 run (the written rows, every layer): the tool centre of every row (and the
 middle of every arc row) at least R + allowance - 1e-6 from the input walls (exact point-segment and
@@ -35,6 +36,7 @@ from fuzzkit import arc_centre, binary, inside, seg_dist  # noqa: E402
 BIN = os.environ.get("TROCHOID", binary("medial-trochoid"))
 CLEAR_TOL, ENG_TOL, ON_LOOP_TOL = 1e-6, 1e-5, 1e-6
 STRATEGY = sys.argv[sys.argv.index("--strategy") + 1] if "--strategy" in sys.argv else None
+THRESHOLDS = [float(t) for t in sys.argv[sys.argv.index("--thresholds") + 1].split(",")] if "--thresholds" in sys.argv else [40, 30]
 
 
 # ---------------------------------------------------------------- geometry of the input loops
@@ -261,9 +263,9 @@ def reread(text):
 def settings(rnd, radii=(2, 3, 5)):
     runs = []
     for R in radii:
-        runs.append((R, rnd.choice([40, 30]), rnd.choice([None, 0.6 * R]), rnd.choice([0, 0.3]), 1))
+        runs.append((R, rnd.choice(THRESHOLDS), rnd.choice([None, 0.6 * R]), rnd.choice([0, 0.3]), 1))
     R = rnd.choice(list(radii))
-    runs.append((R, rnd.choice([40, 30]), rnd.choice([None, 0.6 * R]), rnd.choice([0, 0.3]), 2))
+    runs.append((R, rnd.choice(THRESHOLDS), rnd.choice([None, 0.6 * R]), rnd.choice([0, 0.3]), 2))
     return runs
 
 
@@ -385,7 +387,7 @@ def main():
     argv = sys.argv[1:]
     opt = lambda k, d: argv[argv.index(k) + 1] if k in argv else d
     pos = [a for i, a in enumerate(argv) if not a.startswith("--") and (i == 0 or argv[i - 1] not in
-                                                                         ("--family", "--first", "--jobs", "--keep", "--minutes", "--radii", "--strategy"))]
+                                                                         ("--family", "--first", "--jobs", "--keep", "--minutes", "--radii", "--strategy", "--thresholds"))]
     seeds = int(pos[0]) if pos else 40
     fam = opt("--family", "all")
     first = int(opt("--first", "1"))

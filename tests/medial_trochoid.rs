@@ -924,6 +924,9 @@ fn plan_and_analyse(file: &str, radius: f64, args: &[&str]) -> serde_json::Value
     ] {
         assert_eq!(rep[k], given[k], "{file} R{radius}: {k} planned {} analysed {}", rep[k], given[k]);
     }
+    if rep.get("time_by_kind").is_some() && rep["layers"] == 1 {
+        assert_eq!(rep["time_by_kind"], given["time_by_kind"], "{file} R{radius}");
+    }
     rep
 }
 
@@ -1079,6 +1082,13 @@ fn adaptive_programs_hold_the_target_without_gouge_and_the_report_is_the_written
         assert!(f("uncut_area_mm2") >= 0.0 && r["uncut_at"].is_array(), "{file}: {r}");
         assert!(f("adaptive_minutes") > 0.0 && f("adaptive_constant_feed_minutes") >= f("adaptive_minutes"), "{r}");
         assert!(f("plan_seconds") > 0.0, "{r}");
+        // The time by kind adds up to the program's minutes and length.
+        let kinds = ["full", "light", "air", "link", "entry"];
+        let sum = |k: &str| kinds.iter().map(|s| r["time_by_kind"][s][k].as_f64().unwrap()).sum::<f64>();
+        assert!((sum("minutes") - f("adaptive_minutes")).abs() <= 1e-9 * f("adaptive_minutes"), "{file}: {r}");
+        assert!((sum("mm") - f("length_mm")).abs() <= 1e-6 * f("length_mm"), "{file}: {r}");
+        assert!((r["time_by_kind"]["link"]["mm"].as_f64().unwrap() - f("link_length_mm")).abs() < 1e-6, "{r}");
+        assert_eq!(r["time_by_kind"]["retracts"]["count"].as_f64(), Some(f("retracts_per_layer") - 1.0), "{r}");
     }
 }
 

@@ -48,6 +48,14 @@ struct Walk {
 }
 
 impl Walk {
+    /// Spacing (mm) of a link's engagement checks: with the disks at two checks d apart
+    /// cleared, a circle a and b from them (a + b = d) meets material only outside both, within
+    /// asin(a/2R) + asin(b/2R) ≤ asin(d/2R) on each side of the travel; at d = 2R·sin(target/8)
+    /// that is a quarter of the target in all (and never over a step: the walk's own spacing).
+    fn link_spacing(&self) -> f64 {
+        self.step.min(2.0 * self.r * (0.125 * self.target).sin())
+    }
+
     /// `p` on the grid of written positions.
     fn snap(&self, p: P2) -> P2 {
         self.unit.map_or(p, |u| P2::new((p.x / u).round() * u, (p.y / u).round() * u))
@@ -369,11 +377,11 @@ fn clear_from(
             return;
         };
         target = Some(t);
-        // A link only through cleared ground: its engagement checked every tenth of a step (the
+        // A link only through cleared ground: its engagement checked every `link_spacing` (the
         // whole-program check samples it at other places).
         let link = Seg::Line(at, next);
         if link.length() > camkit::tol::POINT_EPS {
-            if clearance(&link, region) >= w.wall && cutting.along(link, 0.1 * w.step) <= AIR {
+            if clearance(&link, region) >= w.wall && cutting.along(link, w.link_spacing()) <= AIR {
                 out.program.moves.push(Move { seg: link, tag: Tag::Link, retract_before: retract_next });
                 cutting.push(link);
                 retract_next = false;

@@ -13,6 +13,7 @@
 
 pub mod adaptive;
 pub mod angles;
+pub mod breakdown;
 pub mod budget;
 pub mod chords;
 pub mod corner;

@@ -13,6 +13,7 @@ use camkit::io::{Input, Output, write_atomic};
 use camkit::report::Report;
 use camkit::table::{self, Col, Move, Row, Schema, Table, WriteOptions};
 use clap::{Parser, ValueEnum};
+use medial_trochoid::breakdown::Breakdown;
 use medial_trochoid::feed::FeedModel;
 use medial_trochoid::medial::MedialOptions;
 use medial_trochoid::program::Tag;
@@ -725,6 +726,7 @@ fn run_adaptive(
             .set("adaptive_constant_feed_minutes", w.minutes_constant * layers)
             .set("adaptive_chip_only_minutes", w.minutes_chip_only * layers)
             .set("adaptive_constant_feed_chip_only_minutes", w.minutes_constant_chip_only * layers)
+            .set("time_by_kind", Breakdown::of(w, threshold).to_json(layers))
             .set("force_limit_at_deg", settings.feed.force_at)
             .set("length_mm", w.program.moves.iter().map(|m| m.seg.length()).sum::<f64>() * layers)
             .set("contour_length_mm", len(Tag::Contour))
@@ -822,6 +824,7 @@ fn analyse_given(
             .set("force_limit_at_deg", s.feed.force_at)
             .set("chip_only_minutes", a.minutes_chip_only)
             .set("constant_feed_chip_only_minutes", a.minutes_constant_chip_only)
+            .set("time_by_kind", Breakdown::of(&a, s.threshold).to_json(1.0))
             .set("output_rows", out_table.rows.len())
             .set("seconds", started.elapsed().as_secs_f64());
         rep.write(report)?;
