@@ -292,9 +292,47 @@ pub fn offset_contour(c: &Contour, d: f64, side: Side, opts: &OffsetOptions) -> 
             ..Default::default()
         };
         let out = pline.parallel_offset_opt((d + nudge) * side.sign() * k, &o);
-        out.iter().map(|p| scaled(&Contour::from_pline(p), 1.0 / k)).collect()
+        let gap = if closed { KERNEL_PIECE / k } else { 0.0 };
+        out.iter().map(|p| closed_across(scaled(&Contour::from_pline(p), 1.0 / k), gap)).collect()
     })
 }
+
+/// `c` closed if it is open with its ends less than `gap` (mm) apart: cut back to where its
+/// first and last few lines cross, or else joined by a line. Where a bend is within a fraction
+/// of a per cent of R the swallowtail the kernel cuts off is a piece or two of the input long,
+/// and the loop can come back open across it, its ends run a few µm past the crossing or short
+/// of it (the `--wiggle` fuzz: a bend of 0.998 mm at R 1, ends 1.7e-5 mm apart). The result is
+/// verified like every other.
+fn closed_across(mut c: Contour, gap: f64) -> Contour {
+    let n = c.vertices.len();
+    if c.closed || n < 4 || (c.vertices[0].p - c.vertices[n - 1].p).norm() >= gap {
+        return c;
+    }
+    c.closed = true;
+    let line = |i: usize| (c.vertices[i].bulge == 0.0).then(|| (c.vertices[i].p, c.vertices[i + 1].p));
+    let ends = CLOSING_LINES.min((n - 1) / 2);
+    // The crossing that keeps the most: the earliest of the first lines, the latest of the last.
+    let crossing = (0..ends).find_map(|i| {
+        let (a, b) = line(i)?;
+        (n - 1 - ends..n - 1).rev().find_map(|j| {
+            let (p, q) = line(j)?;
+            let (d, e) = (b - a, q - p);
+            let den = crate::geom::cross2(&d, &e);
+            let s = crate::geom::cross2(&(p - a), &e) / den;
+            let t = crate::geom::cross2(&(p - a), &d) / den;
+            ((0.0..=1.0).contains(&s) && (0.0..=1.0).contains(&t)).then(|| (i, j, a + d * s))
+        })
+    });
+    if let Some((i, j, x)) = crossing {
+        let mut kept = vec![super::Vertex { p: x, bulge: 0.0 }];
+        kept.extend_from_slice(&c.vertices[i + 1..=j]);
+        c.vertices = kept;
+    }
+    c
+}
+
+/// Lines at each end of an open loop searched for where they cross ([`closed_across`]).
+const CLOSING_LINES: usize = 8;
 
 /// Median piece length (mm) a kernel run scales its contours up to, at least ([`kernel_scale`]).
 const KERNEL_PIECE: f64 = 1.0;
@@ -705,16 +743,31 @@ mod tests {
         (c, 1.0 / kappa.abs())
     }
 
+    /// A bend within 0.04 % of R (found by the proptest below; the `--wiggle` fuzz found the
+    /// same at a trough 0.2 % tighter than R, seed 18): the swallowtail is a piece or two long
+    /// and the kernel's loop came back open across it at every epsilon, its ends just past the
+    /// crossing. Cut back to the crossing and closed ([`closed_across`]) the loop verifies.
+    #[test]
+    fn a_loop_open_across_a_swallowtail_a_piece_long_is_closed_at_its_crossing() {
+        let b = (50.0f64 / 116.0).powi(2) / 1.2848541147273724;
+        let (c, rho) = wiggle_bend(97_928, (0.0, 3.0), (b, 116.0), 1, true, 0.0066675743857128236);
+        let opts = OffsetOptions::default();
+        let r = rho * (1.0 + 0.0004084106679576869);
+        let o = offset_contour(&c, r, Side::Left, &opts).unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!((o.contours.len(), o.contours[0].closed), (1, true));
+        assert!(check_offset(&[&c], &o.contours, r, Side::Left, true, opts.tol).is_ok());
+    }
+
     proptest::proptest! {
         #![proptest_config(proptest::prelude::ProptestConfig::with_cases(256))]
 
-        /// The class of issue 20's D13: smooth wiggles of 50 000-400 000 lines (a few µm each) at
+        /// The class of issue 20's D13: smooth wiggles of 10 000-400 000 lines (µm long) at
         /// a radius within 4 % of their tightest bend either way, where the offset's swallowtail
         /// is microns across; a stretch of 50-4 000 lines round one bend, closed by a box, bent
         /// both ways (crest offset inward, trough outward). Every run verifies as one loop.
         #[test]
         fn dense_smooth_bends_near_r_offset_whole(
-            n in 50_000usize..400_000,
+            n in 10_000usize..400_000,
             m in 3u32..9,
             big_m in 40u32..150,
             a in 0.0f64..6.0,
