@@ -3,7 +3,7 @@
 must give a verified result (exit 0) or refuse the input naming a crossing (exit 2). Anything
 else (exit 1: no verified offset; a crash) is a defect and its input is kept.
 
-  scripts/fuzz-offset.py [SEEDS] [--spiky | --fine | --fillets | --far | --tiny | --open]
+  scripts/fuzz-offset.py [SEEDS] [--spiky | --fine | --fillets | --far | --tiny | --open | --wiggle]
                                              (offset binary: $OFFSET or target/release/offset)
 
 --spiky widens radii and bulges so that many stars fold across themselves (refusals expected).
@@ -11,7 +11,9 @@ else (exit 1: no verified offset; a crash) is a defect and its input is kept.
 --allow-self-crossing (with it, every run must verify). --fine splits every piece into up to 30
 shorter ones, the line pieces' joints moved off the line by up to 1e-4 mm (near-collinear runs). --fillets rounds every corner with a tangent arc (radius
 0.2-3 mm), the tangency broken by up to 1e-6 rad at random joints. --far moves the star to
-x = 1e5, y = -3e4 mm; --tiny scales the star and every radius and step by 1/100.
+x = 1e5, y = -3e4 mm; --tiny scales the star and every radius and step by 1/100. --wiggle draws
+a smooth closed curve r = 50 + a sin(m t + p) + b sin(M t + q) with 3 000-60 000 lines (issue 20,
+D13), its tightest bends near the radii offset by (0.3-1 mm), both sides and a pocket's first levels.
 """
 import math, os, random, subprocess, sys, tempfile
 
@@ -116,6 +118,20 @@ def walk(seed):
             rows.append(f"0,line,{b[0]!r},{b[1]!r},0,,")
     return "\n".join(rows) + "\n"
 
+def wiggle(seed):
+    """A smooth closed curve of many short lines whose tightest bends come near the offset radii."""
+    rnd = random.Random(seed)
+    n, m, big_m = rnd.randint(3000, 60000), rnd.randint(3, 9), rnd.randint(40, 150)
+    a, p, q = rnd.uniform(0, 6), rnd.uniform(0, 6.3), rnd.uniform(0, 6.3)
+    # The ripple's own bend radius (50 / M)^2 / b spread over 0.25-1.5 mm.
+    b = (50 / big_m) ** 2 / rnd.uniform(0.25, 1.5)
+    rows = ["path,move,x,y,z"]
+    for i in range(n + 1):
+        t = 2 * math.pi * (i % n) / n
+        r = 50 + a * math.sin(m * t + p) + b * math.sin(big_m * t + q)
+        rows.append(f"0,{'rapid' if i == 0 else 'line'},{r * math.cos(t):.9f},{r * math.sin(t):.9f},0")
+    return "\n".join(rows) + "\n"
+
 def star(seed, family):
     rnd = random.Random(seed)
     pieces = filleted(rnd) if family == "fillets" else star_pieces(rnd, family == "spiky")
@@ -138,7 +154,7 @@ def star(seed, family):
 def main():
     args = [a for a in sys.argv[1:] if not a.startswith("--")]
     seeds = int(args[0]) if args else 100
-    families = [f for f in ("spiky", "fine", "fillets", "far", "tiny", "open") if f"--{f}" in sys.argv]
+    families = [f for f in ("spiky", "fine", "fillets", "far", "tiny", "open", "wiggle") if f"--{f}" in sys.argv]
     family = families[0] if families else "smooth"
     k = 0.01 if family == "tiny" else 1
     offset = binary("offset")
@@ -149,12 +165,15 @@ def main():
         # Open paths: both sides, with and without accepting a crossing (then it must verify).
         runs = [["--side", side, "--radius", str(r), *extra]
                 for side in ("left", "right") for r in (0.3, 2, 7) for extra in ([], ["--allow-self-crossing"])]
+    if family == "wiggle":
+        runs = [["--side", side, "--radius", str(r)] for side in ("left", "right") for r in (0.3, 0.5, 1)]
+        runs += [["--radius", "0.5", "--step", "0.5", "--repeat", "2"]]
     counts, kept = {"ok": 0, "refused": 0, "defect": 0}, []
     with tempfile.TemporaryDirectory() as tmp:
         src, out = os.path.join(tmp, "star.csv"), os.path.join(tmp, "out.csv")
         for seed in range(1, seeds + 1):
             with open(src, "w") as f:
-                f.write(walk(seed) if family == "open" else star(seed, family))
+                f.write(walk(seed) if family == "open" else wiggle(seed) if family == "wiggle" else star(seed, family))
             for run in runs:
                 p = subprocess.run([offset, src, *run, "-o", out], capture_output=True, text=True)
                 if p.returncode == 0:

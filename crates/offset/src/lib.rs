@@ -95,27 +95,6 @@ fn self_crossing_error(name: &str, s: &Source, p: P2) -> Error {
     .at(located(name, s.line))
 }
 
-/// Lines of a contour, at least, that make it a curve drawn with chords in [`chords_hint`].
-const CHORDS_MIN: usize = 1000;
-
-/// Why a contour's offset may have failed, for the message: a curve drawn with many lines much
-/// shorter than `r` (at least [`CHORDS_MIN`], a tenth of R on average). Where such a curve bends
-/// tighter than R the kernel (cavalier_contours) must cut off a swallowtail made of hundreds of
-/// tiny raw offset pieces crossing at grazing angles, and its results come back open or missing
-/// stretches at every epsilon (issue 20: the 100 000-vertex wiggle at R 0.5, its tightest bend
-/// 0.46 mm); fitted to arcs the same curve offsets at once.
-fn chords_hint(c: &Contour, r: f64) -> String {
-    let lines: Vec<f64> = c.segs().filter(|s| matches!(s, Seg::Line(..))).map(|s| s.length()).collect();
-    let mean = lines.iter().sum::<f64>() / lines.len().max(1) as f64;
-    if lines.len() < CHORDS_MIN || mean >= 0.1 * r {
-        return String::new();
-    }
-    format!(
-        "; the contour is a curve drawn with {} lines of {mean:.2e} mm on average, which the offset kernel fails on where it bends tighter than R: fit it to arcs first (curve-fit-arcs --tol 1e-5 | offset -)",
-        lines.len()
-    )
-}
-
 /// Contour mode: every pass offset by `r` to `side`, verified.
 pub fn contour_mode(table: &Table, name: &str, r: f64, side: Side, opts: &OffsetOptions) -> Result<Outcome> {
     let mut report = Report::new("offset");
@@ -134,9 +113,8 @@ pub fn contour_mode(table: &Table, name: &str, r: f64, side: Side, opts: &Offset
     let (mut attempts, mut cleaned, mut path) = (0, 0, 0i64);
     let mut drawn = Vec::new();
     for s in &sources {
-        let o = offset_contour(&s.contour, r, side, opts).map_err(|e| {
-            Error::check(format!("path {}: {e}{}", s.path, chords_hint(&s.contour, r))).at(located(name, s.line))
-        })?;
+        let o = offset_contour(&s.contour, r, side, opts)
+            .map_err(|e| Error::check(format!("path {}: {e}", s.path)).at(located(name, s.line)))?;
         attempts += o.attempts;
         cleaned += usize::from(o.cleaned);
         check = check.merge(&o.check);
