@@ -18,7 +18,7 @@
 use super::analytic::Analytic;
 use super::bvh::{Aabb, Bvh};
 use super::cutter::{Cutter, Facet, Owned, Plane, Touch};
-use super::sheet::{Sheet, analytic_pieces, face_pieces};
+use super::sheet::{Sheet, Trim, analytic_pieces, face_pieces};
 use super::{Geometry, Model};
 use crate::geom::{P3, V3};
 use nalgebra::{Isometry3, UnitQuaternion};
@@ -280,7 +280,8 @@ impl DropCutter {
                     Part::Sheet(Sheet::new(b.bezier_pieces().iter().map(|p| p.moved(&place)).collect(), None))
                 }
                 Geometry::Face(f) => {
-                    Part::Sheet(Sheet::new(face_pieces(f).iter().map(|p| p.moved(&place)).collect(), Some(f.clone())))
+                    let trim = Trim::new(f, &place);
+                    Part::Sheet(Sheet::new(face_pieces(f).iter().map(|p| p.moved(&place)).collect(), Some(trim)))
                 }
             };
             let bounds = part_bounds(&part);

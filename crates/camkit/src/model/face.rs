@@ -429,7 +429,7 @@ impl Carrier {
     }
 
     /// The carrier's normal at a point on it.
-    fn normal_at(&self, p: &P3) -> V3 {
+    pub fn normal_at(&self, p: &P3) -> V3 {
         match self {
             Carrier::Analytic(a) => a.foot(p).normal,
             Carrier::Patch(s) => s.nearest(p, f64::INFINITY).expect("an unbounded query finds a point").0.normal,

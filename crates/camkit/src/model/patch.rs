@@ -156,7 +156,7 @@ pub(super) fn basis_derivs(knots: &[f64], s: usize, p: usize, t: f64) -> [[f64; 
 
 /// Knots and control points (rows of any width, combined linearly) of the same spline with every
 /// knot of the domain inserted until it is at least `p`-fold.
-fn bezier_knots(knots: &[f64], mut pts: Vec<Vec<f64>>, p: usize) -> (Vec<f64>, Vec<Vec<f64>>) {
+pub(super) fn bezier_knots(knots: &[f64], mut pts: Vec<Vec<f64>>, p: usize) -> (Vec<f64>, Vec<Vec<f64>>) {
     let mut knots = knots.to_vec();
     let (start, end) = (knots[p], knots[pts.len()]);
     let mut values: Vec<f64> = knots.iter().copied().filter(|&t| t >= start && t <= end).collect();
@@ -182,7 +182,7 @@ fn bezier_knots(knots: &[f64], mut pts: Vec<Vec<f64>>, p: usize) -> (Vec<f64>, V
 
 /// The non-empty spans of a Bézier-form knot vector: the index of each one's last point and its
 /// ends.
-fn bezier_spans(knots: &[f64], p: usize) -> Vec<(usize, f64, f64)> {
+pub(super) fn bezier_spans(knots: &[f64], p: usize) -> Vec<(usize, f64, f64)> {
     let n = knots.len() - p - 1;
     (p..n).filter(|&k| knots[k] < knots[k + 1]).map(|k| (k, knots[k], knots[k + 1])).collect()
 }
