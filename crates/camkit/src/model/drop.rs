@@ -11,9 +11,12 @@
 //! own plane does not. Each corner and edge shared by several triangles is tested in one of
 //! them, and a drop along a line starts from the tip touching the contact before. Planes, spheres and cylinders across or along the axis
 //! have closed forms, and so have a ball on an endless cylinder at a slant and a flat, ball or
-//! bull-nose on a torus or a finite cone along the axis. Other surfaces (other cones, tori and
-//! cylinders at a slant, free-form patches) are refused by [`DropCutter::new`]: tessellate them
-//! to STL.
+//! bull-nose on a torus or a finite cone along the axis. Every other surface (B-spline patches,
+//! trimmed STEP faces, finite cylinders across the axis or at a slant, endless ones at a slant
+//! under a flat, bull-nose or cone, cones and tori at any angle or under a cone cutter) is made
+//! exact rational Bézier patches and searched by [`super::sheet`] to its 1e-9 mm. Only what has
+//! no top along the axis (a plane along it, an endless cylinder along it, a cylinder or cone
+//! endless one way) is refused by [`DropCutter::new`].
 
 use super::analytic::Analytic;
 use super::bvh::{Aabb, Bvh};

@@ -17,9 +17,9 @@
 //! [`TOL`] above the best point found, so the tip found is exact to [`TOL`] below (and a point of
 //! the surface, with its normal).
 
+use super::analytic::Analytic;
 use super::bvh::Aabb;
 use super::cutter::{Cutter, Plane, Touch};
-use super::analytic::Analytic;
 use super::face::{Carrier, Curve, Face};
 use crate::geom::{P3, V3};
 use nalgebra::Isometry3;
@@ -205,8 +205,10 @@ impl Bezier {
     fn longest(&self) -> usize {
         let [p, q] = self.deg;
         let at = |i: usize, j: usize| cart(&self.pts[i * (q + 1) + j]);
-        let along_s = (0..=q).map(|j| (0..p).map(|i| (at(i + 1, j) - at(i, j)).norm()).sum::<f64>()).fold(0.0, f64::max);
-        let along_t = (0..=p).map(|i| (0..q).map(|j| (at(i, j + 1) - at(i, j)).norm()).sum::<f64>()).fold(0.0, f64::max);
+        let along_s =
+            (0..=q).map(|j| (0..p).map(|i| (at(i + 1, j) - at(i, j)).norm()).sum::<f64>()).fold(0.0, f64::max);
+        let along_t =
+            (0..=p).map(|i| (0..q).map(|j| (at(i, j + 1) - at(i, j)).norm()).sum::<f64>()).fold(0.0, f64::max);
         usize::from(along_t > along_s)
     }
 }
@@ -257,7 +259,11 @@ impl Trim {
                                 [p.x, p.y, p.z, c[2]]
                             })
                             .collect();
-                        edges.push(Edge::Piece(Bezier::new([2, 0], pts, [m, Map::Linear(0.0, 0.0)]).moved(place), 0.0, 1.0));
+                        edges.push(Edge::Piece(
+                            Bezier::new([2, 0], pts, [m, Map::Linear(0.0, 0.0)]).moved(place),
+                            0.0,
+                            1.0,
+                        ));
                     }
                 }
                 Curve::Spline { curve, t0, t1 } => {
@@ -551,7 +557,14 @@ impl Sheet {
             let bound = self.bound(c, q, net, false);
             if bound > floor && b.max.z > f64::NEG_INFINITY {
                 if let Some(side) = self.side(k, &[0.0, 1.0, 0.0, 1.0]) {
-                    heap.push(Node { bound, piece: k, net: net.clone(), rect: [0.0, 1.0, 0.0, 1.0], full: false, side });
+                    heap.push(Node {
+                        bound,
+                        piece: k,
+                        net: net.clone(),
+                        rect: [0.0, 1.0, 0.0, 1.0],
+                        full: false,
+                        side,
+                    });
                 }
             }
         }
@@ -586,8 +599,10 @@ impl Sheet {
                     Edge::Piece(net, lo, hi) => drop_curve(c, q, |s| net.eval(s, 0.0).0, *lo, *hi),
                 };
                 if let Some((g, p)) = found.filter(|f| f.0 > level(&best)) {
-                    let n = trim.place.rotation * trim.face.carrier().normal_at(&trim.place.inverse_transform_point(&p));
-                    let n = if n.z < 0.0 || (n.z == 0.0 && n.x * (q[0] - p.x) + n.y * (q[1] - p.y) < 0.0) { -n } else { n };
+                    let n =
+                        trim.place.rotation * trim.face.carrier().normal_at(&trim.place.inverse_transform_point(&p));
+                    let n =
+                        if n.z < 0.0 || (n.z == 0.0 && n.x * (q[0] - p.x) + n.y * (q[1] - p.y) < 0.0) { -n } else { n };
                     best = Some((g, p, n));
                 }
             }
@@ -624,7 +639,8 @@ impl Sheet {
             };
             let mid = feasible(&node, 0.5, 0.5);
             take(mid);
-            let edges = [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0), (0.5, 0.0), (1.0, 0.5), (0.5, 1.0), (0.0, 0.5)];
+            let edges =
+                [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0), (0.5, 0.0), (1.0, 0.5), (0.5, 1.0), (0.0, 0.5)];
             for (s, t) in edges {
                 let at = feasible(&node, s, t);
                 if at.is_some() == mid.is_some() {
@@ -743,7 +759,9 @@ pub fn face_pieces(face: &Face) -> Vec<Bezier> {
             let pts = vec![[u0, v0, 0.0, 1.0], [u0, v1, 0.0, 1.0], [u1, v0, 0.0, 1.0], [u1, v1, 0.0, 1.0]];
             vec![Bezier::new([1, 1], pts, [Map::Linear(u0, u1), Map::Linear(v0, v1)])]
         }
-        Carrier::Analytic(Analytic::Cylinder { radius, .. }) => revolve(&line([*radius, v0], [*radius, v1], v0, v1), u0, u1),
+        Carrier::Analytic(Analytic::Cylinder { radius, .. }) => {
+            revolve(&line([*radius, v0], [*radius, v1], v0, v1), u0, u1)
+        }
         Carrier::Analytic(Analytic::Cone { apex, half_angle, .. }) => {
             let rho = |v: f64| (v - apex.z) * half_angle.tan();
             revolve(&line([rho(v0), v0], [rho(v1), v1], v0, v1), u0, u1)
@@ -797,7 +815,8 @@ mod tests {
     #[test]
     fn arcs_map_to_their_angles() {
         for (h, m) in arcs(-0.3, 5.0) {
-            let net = Bezier::new([2, 0], h.iter().map(|p| [p[0], p[1], 0.0, p[2]]).collect(), [m, Map::Linear(0.0, 1.0)]);
+            let net =
+                Bezier::new([2, 0], h.iter().map(|p| [p[0], p[1], 0.0, p[2]]).collect(), [m, Map::Linear(0.0, 1.0)]);
             for k in 0..=10 {
                 let s = k as f64 / 10.0;
                 let (p, _, _) = net.eval(s, 0.0);
@@ -812,9 +831,14 @@ mod tests {
     fn bezier_pieces_are_the_spline() {
         // A rational, unevenly knotted bicubic-by-quadratic net.
         let net: Vec<Vec<P3>> = (0..6)
-            .map(|i| (0..5).map(|j| P3::new(i as f64 * 3.0, j as f64 * 2.0 + (i * j) as f64 * 0.1, ((i + 2 * j) % 5) as f64)).collect())
+            .map(|i| {
+                (0..5)
+                    .map(|j| P3::new(i as f64 * 3.0, j as f64 * 2.0 + (i * j) as f64 * 0.1, ((i + 2 * j) % 5) as f64))
+                    .collect()
+            })
             .collect();
-        let w: Vec<Vec<f64>> = (0..6).map(|i| (0..5).map(|j| 0.5 + ((i * 7 + j * 3) % 5) as f64 * 0.3).collect()).collect();
+        let w: Vec<Vec<f64>> =
+            (0..6).map(|i| (0..5).map(|j| 0.5 + ((i * 7 + j * 3) % 5) as f64 * 0.3).collect()).collect();
         let ku = vec![0.0, 0.0, 0.0, 0.0, 0.3, 0.3, 1.0, 1.0, 1.0, 1.0];
         let kv = vec![0.0, 0.0, 0.0, 0.2, 0.7, 1.0, 1.0, 1.0];
         let s = BSpline::with_weights(&net, Some(&w), [3, 2], Some(ku), Some(kv));
@@ -947,5 +971,4 @@ mod tests {
             }
         }
     }
-
 }
