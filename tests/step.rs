@@ -255,7 +255,7 @@ fn fixed_axis_cutters_on_step_faces() {
                 assert!(d <= 1e-9, "{name} {model} {region}: STEP and JSON tips differ by {d}");
             }
         }
-        let block = tips("step/block.step", &tool, "-5,45,-5,45", "b.csv");
-        assert!(block.len() > 300, "{name}: {} rows on the block", block.len());
+        let block = tips("step/block.step", &tool, "-5,35,-5,35", "b.csv");
+        assert!(block.len() > 150, "{name}: {} rows on the block", block.len());
     }
 }

@@ -199,6 +199,18 @@ const ACROSS: f64 = 1e-12;
 impl DropCutter {
     /// The model turned into the frame of `axis`, every surface checked.
     pub fn new(model: &Model, cutter: Cutter, axis: V3) -> Result<DropCutter, Unsupported> {
+        DropCutter::build(model, cutter, axis, true)
+    }
+
+    /// [`DropCutter::new`] where every surface has a closed form (meshes too), refusing those
+    /// searched by [`super::sheet`]: for the quick start heights of stylus-trace's scan and the
+    /// relief grid of plots, which fall back to nearest points there.
+    pub fn closed_forms(model: &Model, cutter: Cutter, axis: V3) -> Result<DropCutter, Unsupported> {
+        DropCutter::build(model, cutter, axis, false)
+    }
+
+    /// [`DropCutter::new`], with the searched surfaces if `search`.
+    fn build(model: &Model, cutter: Cutter, axis: V3, search: bool) -> Result<DropCutter, Unsupported> {
         let frame = AxisFrame::new(axis);
         let mut parts = Vec::with_capacity(model.surfaces.len());
         for (i, s) in model.surfaces.iter().enumerate() {
@@ -287,6 +299,9 @@ impl DropCutter {
                     Part::Sheet(Sheet::new(face_pieces(f).iter().map(|p| p.moved(&place)).collect(), Some(trim)))
                 }
             };
+            if !search && matches!(part, Part::Sheet(_) | Part::Tube { .. }) {
+                return Err(refuse("no closed form: searched by the drop-cutter's branch-and-bound"));
+            }
             let bounds = part_bounds(&part);
             parts.push((part, bounds));
         }
