@@ -1178,6 +1178,7 @@ fn fixed_axis_cutters_on_analytic_models() {
     }
     // Flat R2 on the same slanted cylinder R3 (its top z = (x cos θ + √(9 − y²)) / sin θ): the
     // tip is the highest of that over the disc, never below a dense sampling of it.
+    let (th, axis) = (50f64.to_radians(), V3::new(50f64.to_radians().sin(), 0.0, 50f64.to_radians().cos()));
     let rows = run("slant.json", "flat.json", &["--region=-4,4,-3,3"]);
     assert!(rows.len() > 200);
     for (tip, _, contact, ..) in &rows {
