@@ -314,8 +314,8 @@ impl BSpline {
             for (b, va, vb) in bezier_spans(&kv, q) {
                 let mut pts = Vec::with_capacity((p + 1) * (q + 1));
                 for i in a - p..=a {
-                    for j in b - q..=b {
-                        let c = &cols[j][4 * i..4 * i + 4];
+                    for col in &cols[b - q..=b] {
+                        let c = &col[4 * i..4 * i + 4];
                         pts.push([c[0], c[1], c[2], c[3]]);
                     }
                 }
