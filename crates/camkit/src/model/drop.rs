@@ -914,8 +914,25 @@ mod tests {
             assert!((got.tip.z - want).abs() < 1e-12, "e {e}: {} vs {want}", got.tip.z);
             assert!((got.contact - P3::new(rim, 0.0, 10.0)).norm() < 1e-12);
         }
-        let e = DropCutter::new(&m, Cutter::Cone { radius: 1.0, half_angle: 0.5 }, V3::z()).unwrap_err();
-        assert!(e.what.contains("cone is handled"), "{e:?}");
+        // A cone cutter in the funnel (searched): never below a dense sampling of the wall, the
+        // contact on it.
+        let c = Cutter::Cone { radius: 1.0, half_angle: 0.5 };
+        let dc = DropCutter::new(&m, c, V3::z()).unwrap();
+        for d in [0.0, 0.7, 3.0, 5.5] {
+            let got = dc.drop(-d, 0.0).unwrap();
+            let points: Vec<P3> = (0..=400)
+                .flat_map(|i| {
+                    (0..=400).map(move |j| {
+                        let (t, a) = (10.0 * i as f64 / 400.0, std::f64::consts::TAU * j as f64 / 400.0);
+                        P3::new(t * th.tan().recip() * a.cos(), t * th.tan().recip() * a.sin(), t)
+                    })
+                })
+                .collect();
+            let brute = sampled(&c, &dc.frame, [-d, 0.0], &points);
+            assert!(brute <= got.tip.z + 1e-9 && got.tip.z - brute < 5e-3, "d {d}: {} vs sampled {brute}", got.tip.z);
+            let p = got.contact;
+            assert!((p.x.hypot(p.y) * th.tan() - p.z).abs() < 1e-9, "{p:?}");
+        }
     }
 
     proptest! {
