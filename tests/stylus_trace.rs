@@ -1176,8 +1176,25 @@ fn fixed_axis_cutters_on_analytic_models() {
         let want = (tip.x.hypot(tip.y) + 2.5) * th.tan() + 1.5 * (1.0 / th.cos() - 1.0);
         assert!((tip.z - want).abs() < 1e-9, "{tip}: {want}");
     }
-    w.run(BIN, &["slant.json", "--tool", "flat.json", "--region=-4,4,-6,6", "-o", "f.csv"], b"")
-        .fails(2, "a cylinder at a slant to the tool axis (handled for a ball cutter on an endless one)");
+    // Flat R2 on the same slanted cylinder R3 (its top z = (x cos θ + √(9 − y²)) / sin θ): the
+    // tip is the highest of that over the disc, never below a dense sampling of it.
+    let (th, axis) = (50f64.to_radians(), V3::new(50f64.to_radians().sin(), 0.0, 50f64.to_radians().cos()));
+    let rows = run("slant.json", "flat.json", &["--region=-4,4,-3,3"]);
+    assert!(rows.len() > 200);
+    for (tip, _, contact, ..) in &rows {
+        let mut brute = f64::NEG_INFINITY;
+        for i in -60..=60 {
+            for j in -60..=60 {
+                let (x, y) = (tip.x + i as f64 / 30.0, tip.y + j as f64 / 30.0);
+                if (x - tip.x).hypot(y - tip.y) <= 2.0 && y.abs() <= 3.0 {
+                    brute = brute.max((x * th.cos() + (9.0 - y * y).sqrt()) / th.sin());
+                }
+            }
+        }
+        assert!(tip.z >= brute - 1e-9 && tip.z - brute < 0.05, "{tip}: sampled {brute}");
+        let radial = contact.coords - axis * contact.coords.dot(&axis);
+        assert!((radial.norm() - 3.0).abs() < 1e-9 && (contact.z - tip.z).abs() < 1e-12);
+    }
     let threads = |n: &str| {
         let args = ["--tool", "ball.json", "--pick", "0.5", "--max-step", "0.5", "--axis", "1,-1,2", "--threads", n];
         w.run(BIN, &[&["sphere.json"][..], &args].concat(), b"")
@@ -1201,8 +1218,9 @@ fn fixed_axis_bad_input() {
         .fails(2, "bull.json:1:48 (corner_radius): corner_radius 4 exceeds the radius 3");
     go(&["sphere.json", "--tool", "cone.json"]).fails(2, "cone.json:1:1 (half_angle): a cone cutter needs half_angle");
     go(&["sphere.json", "--tool", "cyl.json"]).fails(2, "does not rotate");
-    go(&["torus.json", "--tool", "ball.json", "--axis", "1,0,1"])
-        .fails(2, "torus.json: surface torus#0: a torus is handled by the drop-cutter only along the tool axis");
+    w.write("wall.json", r#"{"surfaces": [{"type": "plane", "point": [0, 0, 0], "normal": [1, 0, 0]}]}"#);
+    go(&["wall.json", "--tool", "ball.json"])
+        .fails(2, "wall.json: surface plane#0: a plane along the tool axis has no top for the cutter to rest on");
     go(&["sphere.json", "--tool", "ball.json", "--mode", "contour"]).fails(2, "--mode scan only");
     go(&["sphere.json", "--tool", "ball.json", "--axis", "0,0,0"]).fails(2, "--axis must be a nonzero direction");
     go(&["sphere.json", "--tool", "ball.json", "--region=20,30,20,30"]).fails(2, "misses the model");

@@ -107,7 +107,7 @@ pub fn trace(model: &Model, opts: &Options, tick: &(dyn Fn() + Sync)) -> Result<
     let nested: Vec<Vec<TracedPath>> = match &opts.mode {
         Mode::Scan(s) => {
             // The exact ball drop where every surface has one (starts of drops, see scan.rs).
-            let exact = DropCutter::new(model, Cutter::Ball { radius: stylus.radius }, V3::z()).ok();
+            let exact = DropCutter::closed_forms(model, Cutter::Ball { radius: stylus.radius }, V3::z()).ok();
             scan::lines(s)
                 .par_iter()
                 .enumerate()

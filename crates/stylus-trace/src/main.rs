@@ -143,8 +143,10 @@ trimmed by their edges).\n\n",
         "\nWith --tool (fixed-axis cutter, scan mode only): x,y,z the tool tip, i,j,k the axis, px,py,pz the\n\
          contact, nx,ny,nz the model's unit normal there, tag `drop`, surface, point `tip`. The drop is exact\n\
          on STL meshes (facet, vertex and edge tests; the bull-nose edge within 1e-10 mm), planes,\n\
-         spheres and cylinders across the axis (endless) or along it (the upper rim); other surfaces\n\
-         are refused.\n",
+         spheres and cylinders across the axis (endless) or along it (the upper rim), tori and cones\n\
+         along it; on B-spline patches, trimmed STEP faces and every other analytic surface to 1e-9 mm\n\
+         (a branch-and-bound over exact rational Bezier pieces; docs/formats.md). Planes along the axis\n\
+         and endless cylinders along it (no top) are refused.\n",
     );
     s.push_str(
         "\nScan mode checks every line against an independent drop of the stylus: a stretch with the model under it\n\

@@ -11,13 +11,17 @@
 //! own plane does not. Each corner and edge shared by several triangles is tested in one of
 //! them, and a drop along a line starts from the tip touching the contact before. Planes, spheres and cylinders across or along the axis
 //! have closed forms, and so have a ball on an endless cylinder at a slant and a flat, ball or
-//! bull-nose on a torus or a finite cone along the axis. Other surfaces (other cones, tori and
-//! cylinders at a slant, free-form patches) are refused by [`DropCutter::new`]: tessellate them
-//! to STL.
+//! bull-nose on a torus or a finite cone along the axis. Every other surface (B-spline patches,
+//! trimmed STEP faces, finite cylinders across the axis or at a slant, endless ones at a slant
+//! under a flat, bull-nose or cone, cones and tori at any angle or under a cone cutter) is made
+//! exact rational Bézier patches and searched by [`super::sheet`] to its 1e-9 mm. Only what has
+//! no top along the axis (a plane along it, an endless cylinder along it, a cylinder or cone
+//! endless one way) is refused by [`DropCutter::new`].
 
 use super::analytic::Analytic;
 use super::bvh::{Aabb, Bvh};
 use super::cutter::{Cutter, Facet, Owned, Plane, Touch};
+use super::sheet::{Sheet, Trim, analytic_pieces, face_pieces};
 use super::{Geometry, Model};
 use crate::geom::{P3, V3};
 use nalgebra::{Isometry3, UnitQuaternion};
@@ -78,6 +82,12 @@ enum Part {
     /// A finite cone along the tool axis, for a flat, ball or bull-nose: a point of its axis and
     /// its section's ends (distance from the axis, height).
     Revolved { centre: P3, ends: [[f64; 2]; 2] },
+    /// Smooth pieces (B-spline patches, a face's carrier, other finite analytic surfaces) as
+    /// rational Bézier patches, searched by [`Sheet::drop`].
+    Sheet(Sheet),
+    /// An endless cylinder at a slant, for a flat, bull-nose or cone: a point of its axis, the
+    /// unit axis, the radius (the length under the cutter made a sheet at each drop).
+    Tube { point: P3, axis: V3, radius: f64 },
 }
 
 /// The bits of a point (−0 as 0): equal points give equal drops.
@@ -189,6 +199,18 @@ const ACROSS: f64 = 1e-12;
 impl DropCutter {
     /// The model turned into the frame of `axis`, every surface checked.
     pub fn new(model: &Model, cutter: Cutter, axis: V3) -> Result<DropCutter, Unsupported> {
+        DropCutter::build(model, cutter, axis, true)
+    }
+
+    /// [`DropCutter::new`] where every surface has a closed form (meshes too), refusing those
+    /// searched by [`super::sheet`]: for the quick start heights of stylus-trace's scan and the
+    /// relief grid of plots, which fall back to nearest points there.
+    pub fn closed_forms(model: &Model, cutter: Cutter, axis: V3) -> Result<DropCutter, Unsupported> {
+        DropCutter::build(model, cutter, axis, false)
+    }
+
+    /// [`DropCutter::new`], with the searched surfaces if `search`.
+    fn build(model: &Model, cutter: Cutter, axis: V3, search: bool) -> Result<DropCutter, Unsupported> {
         let frame = AxisFrame::new(axis);
         let mut parts = Vec::with_capacity(model.surfaces.len());
         for (i, s) in model.surfaces.iter().enumerate() {
@@ -215,16 +237,19 @@ impl DropCutter {
                 Geometry::Analytic(Analytic::Sphere { centre, radius }) => {
                     Part::Sphere { centre: pt(centre), radius: *radius }
                 }
-                Geometry::Analytic(Analytic::Cylinder { point, axis, radius, from, to }) => {
+                Geometry::Analytic(whole @ Analytic::Cylinder { point, axis, radius, from, to }) => {
                     let (p, a) = (pt(point), vec(axis));
                     if a.z.abs() <= ACROSS {
                         let a = V3::new(a.x, a.y, 0.0).normalize();
-                        if from.is_finite() || to.is_finite() {
+                        if from.is_finite() && to.is_finite() {
+                            sheet(whole, &place)
+                        } else if from.is_finite() || to.is_finite() {
                             return Err(refuse(
-                                "a cylinder of finite length across the tool axis (its end circles are not handled): give it no length, or tessellate it",
+                                "a cylinder across the tool axis endless one way only: give it both ends or none",
                             ));
+                        } else {
+                            Part::Across { point: p, axis: a, radius: *radius, from: *from, to: *to }
                         }
-                        Part::Across { point: p, axis: a, radius: *radius, from: *from, to: *to }
                     } else if a.z.abs() >= 1.0 - ACROSS {
                         if !(from.is_finite() && to.is_finite()) {
                             return Err(refuse("an endless cylinder along the tool axis has no top"));
@@ -232,45 +257,51 @@ impl DropCutter {
                         let top = if a.z > 0.0 { *to } else { *from };
                         let centre = p + a * top;
                         Part::Rim { centre, radius: *radius }
-                    } else if matches!(cutter, Cutter::Ball { .. }) && !from.is_finite() && !to.is_finite() {
-                        Part::Slant { point: p, axis: a, radius: *radius }
+                    } else if !from.is_finite() && !to.is_finite() {
+                        if matches!(cutter, Cutter::Ball { .. }) {
+                            Part::Slant { point: p, axis: a, radius: *radius }
+                        } else {
+                            Part::Tube { point: p, axis: a, radius: *radius }
+                        }
+                    } else if from.is_finite() && to.is_finite() {
+                        sheet(whole, &place)
                     } else {
                         return Err(refuse(
-                            "a cylinder at a slant to the tool axis (handled for a ball cutter on an endless one): tessellate it to STL",
+                            "a cylinder at a slant to the tool axis endless one way only: give it both ends or none",
                         ));
                     }
                 }
-                Geometry::Analytic(Analytic::Cone { apex, axis, half_angle, from, to }) => {
+                Geometry::Analytic(whole @ Analytic::Cone { apex, axis, half_angle, from, to }) => {
                     let a = vec(axis);
-                    if a.z.abs() < 1.0 - ACROSS
-                        || !(from.is_finite() && to.is_finite())
-                        || matches!(cutter, Cutter::Cone { .. })
-                    {
-                        return Err(refuse(
-                            "a cone is handled by the drop-cutter only along the tool axis, of finite length, and for a flat, ball or bull-nose cutter: tessellate it to STL",
-                        ));
+                    if !(from.is_finite() && to.is_finite()) {
+                        return Err(refuse("an endless cone has no top for the cutter to rest on: give it a length"));
                     }
-                    let apex = pt(apex);
-                    let end = |t: f64| [t * half_angle.tan(), apex.z + a.z.signum() * t];
-                    Part::Revolved { centre: apex, ends: [end(*from), end(*to)] }
+                    if a.z.abs() < 1.0 - ACROSS || matches!(cutter, Cutter::Cone { .. }) {
+                        sheet(whole, &place)
+                    } else {
+                        let apex = pt(apex);
+                        let end = |t: f64| [t * half_angle.tan(), apex.z + a.z.signum() * t];
+                        Part::Revolved { centre: apex, ends: [end(*from), end(*to)] }
+                    }
                 }
-                Geometry::Analytic(Analytic::Torus { centre, axis, major, minor }) => {
+                Geometry::Analytic(whole @ Analytic::Torus { centre, axis, major, minor }) => {
                     if vec(axis).z.abs() < 1.0 - ACROSS || matches!(cutter, Cutter::Cone { .. }) {
-                        return Err(refuse(
-                            "a torus is handled by the drop-cutter only along the tool axis and for a flat, ball or bull-nose cutter: tessellate it to STL",
-                        ));
+                        sheet(whole, &place)
+                    } else {
+                        Part::Torus { centre: pt(centre), major: *major, minor: *minor }
                     }
-                    Part::Torus { centre: pt(centre), major: *major, minor: *minor }
                 }
-                Geometry::Patch(_) => {
-                    return Err(refuse("free-form patches are not handled by the drop-cutter: tessellate them to STL"));
+                Geometry::Patch(b) => {
+                    Part::Sheet(Sheet::new(b.bezier_pieces().iter().map(|p| p.moved(&place)).collect(), None))
                 }
-                Geometry::Face(_) => {
-                    return Err(refuse(
-                        "trimmed STEP faces are not handled by the drop-cutter: tessellate them to STL",
-                    ));
+                Geometry::Face(f) => {
+                    let trim = Trim::new(f, &place);
+                    Part::Sheet(Sheet::new(face_pieces(f).iter().map(|p| p.moved(&place)).collect(), Some(trim)))
                 }
             };
+            if !search && matches!(part, Part::Sheet(_) | Part::Tube { .. }) {
+                return Err(refuse("no closed form: searched by the drop-cutter's branch-and-bound"));
+            }
             let bounds = part_bounds(&part);
             parts.push((part, bounds));
         }
@@ -423,6 +454,20 @@ impl DropCutter {
                 let contact = P3::new(centre.x + ux * p[0], centre.y + uy * p[0], p[1]);
                 Some((Touch { tip, contact }, V3::new(ux * n[0], uy * n[0], n[1])))
             }
+            Part::Sheet(sheet) => sheet.drop(c, q, floor),
+            Part::Tube { point, axis, radius } => {
+                // The axis's points whose circle can reach the shadow: |(P(t) − q).xy| ≤ R + r.
+                let (ex, ey) = (point.x - q[0], point.y - q[1]);
+                let aa = axis.x * axis.x + axis.y * axis.y;
+                let bb = ex * axis.x + ey * axis.y;
+                let disc = bb * bb - aa * (ex * ex + ey * ey - (c.radius() + radius).powi(2));
+                if disc < 0.0 {
+                    return None;
+                }
+                let (from, to) = ((-bb - disc.sqrt()) / aa, (-bb + disc.sqrt()) / aa);
+                let cyl = Analytic::Cylinder { point: *point, axis: *axis, radius: *radius, from, to };
+                Sheet::new(analytic_pieces(&cyl).expect("a finite cylinder"), None).drop(c, q, floor)
+            }
             Part::Rim { centre, radius } => {
                 let (dx, dy) = (q[0] - centre.x, q[1] - centre.y);
                 let d = dx.hypot(dy);
@@ -438,6 +483,12 @@ impl DropCutter {
     }
 }
 
+/// A finite analytic surface made rational patches, moved into the axis frame by `place`.
+fn sheet(a: &Analytic, place: &Isometry3<f64>) -> Part {
+    let pieces = analytic_pieces(a).expect("a finite surface");
+    Part::Sheet(Sheet::new(pieces.iter().map(|p| p.moved(place)).collect(), None))
+}
+
 /// The rigid motion from a surface's own frame to the axis frame.
 fn frame_of(frame: &AxisFrame, placement: Option<&Isometry3<f64>>) -> Isometry3<f64> {
     let turn = Isometry3::from_parts(nalgebra::Translation3::identity(), frame.rotation);
@@ -451,6 +502,8 @@ fn frame_of(frame: &AxisFrame, placement: Option<&Isometry3<f64>>) -> Isometry3<
 fn part_bounds(part: &Part) -> Aabb {
     match part {
         Part::Mesh { index, .. } => index.bounds(),
+        Part::Sheet(sheet) => sheet.bounds(),
+        Part::Tube { .. } => Aabb::everything(),
         Part::Plane { .. } | Part::Across { .. } | Part::Slant { .. } => Aabb::everything(),
         Part::Sphere { centre, radius } => {
             Aabb { min: centre - V3::repeat(*radius), max: centre + V3::repeat(*radius) }
@@ -861,8 +914,25 @@ mod tests {
             assert!((got.tip.z - want).abs() < 1e-12, "e {e}: {} vs {want}", got.tip.z);
             assert!((got.contact - P3::new(rim, 0.0, 10.0)).norm() < 1e-12);
         }
-        let e = DropCutter::new(&m, Cutter::Cone { radius: 1.0, half_angle: 0.5 }, V3::z()).unwrap_err();
-        assert!(e.what.contains("cone is handled"), "{e:?}");
+        // A cone cutter in the funnel (searched): never below a dense sampling of the wall, the
+        // contact on it.
+        let c = Cutter::Cone { radius: 1.0, half_angle: 0.5 };
+        let dc = DropCutter::new(&m, c, V3::z()).unwrap();
+        for d in [0.0, 0.7, 3.0, 5.5] {
+            let got = dc.drop(-d, 0.0).unwrap();
+            let points: Vec<P3> = (0..=400)
+                .flat_map(|i| {
+                    (0..=400).map(move |j| {
+                        let (t, a) = (10.0 * i as f64 / 400.0, std::f64::consts::TAU * j as f64 / 400.0);
+                        P3::new(t * th.tan().recip() * a.cos(), t * th.tan().recip() * a.sin(), t)
+                    })
+                })
+                .collect();
+            let brute = sampled(&c, &dc.frame, [-d, 0.0], &points);
+            assert!(brute <= got.tip.z + 1e-9 && got.tip.z - brute < 5e-3, "d {d}: {} vs sampled {brute}", got.tip.z);
+            let p = got.contact;
+            assert!((p.x.hypot(p.y) * th.tan() - p.z).abs() < 1e-9, "{p:?}");
+        }
     }
 
     proptest! {
@@ -955,25 +1025,31 @@ mod tests {
 
     #[test]
     fn refuses_what_it_cannot_drop_onto() {
-        let m = model(
-            r#"{"surfaces": [{"type": "torus", "centre": [0,0,0], "axis": [0,0,1], "major_radius": 5, "minor_radius": 1}]}"#,
-        );
-        assert!(DropCutter::new(&m, Cutter::Ball { radius: 1.0 }, V3::z()).is_ok());
-        let e = DropCutter::new(&m, Cutter::Cone { radius: 1.0, half_angle: 0.5 }, V3::z()).unwrap_err();
-        assert!(e.what.contains("torus"), "{e:?}");
-        let e = DropCutter::new(&m, Cutter::Ball { radius: 1.0 }, V3::x()).unwrap_err();
-        assert!(e.what.contains("torus"), "{e:?}");
-        let m = model(r#"{"surfaces": [{"type": "plane", "point": [0,0,0], "normal": [1,0,0]}]}"#);
-        assert!(DropCutter::new(&m, Cutter::Ball { radius: 1.0 }, V3::z()).is_err());
-        assert!(DropCutter::new(&m, Cutter::Ball { radius: 1.0 }, V3::x()).is_ok());
-        // A slanted cylinder: a ball on an endless one only.
-        let m = model(r#"{"surfaces": [{"type": "cylinder", "point": [0,0,0], "axis": [1,0,1], "radius": 1}]}"#);
-        assert!(DropCutter::new(&m, Cutter::Ball { radius: 1.0 }, V3::z()).is_ok());
-        let e = DropCutter::new(&m, Cutter::Flat { radius: 1.0 }, V3::z()).unwrap_err();
-        assert!(e.what.contains("slant"), "{e:?}");
-        let m = model(
-            r#"{"surfaces": [{"type": "cylinder", "point": [0,0,0], "axis": [1,0,1], "radius": 1, "length": [0, 5]}]}"#,
-        );
-        assert!(DropCutter::new(&m, Cutter::Ball { radius: 1.0 }, V3::z()).is_err());
+        // What has no top along the axis, or no end one way.
+        for (text, what) in [
+            (r#"{"type": "plane", "point": [0,0,0], "normal": [1,0,0]}"#, "plane"),
+            (r#"{"type": "cylinder", "point": [0,0,0], "axis": [0,0,1], "radius": 1}"#, "along the tool axis"),
+        ] {
+            let m = model(&format!(r#"{{"surfaces": [{text}]}}"#));
+            for c in CUTTERS {
+                let e = DropCutter::new(&m, c, V3::z()).unwrap_err();
+                assert!(e.what.contains(what), "{e:?}");
+            }
+        }
+        // Everything else is dropped onto, whatever the cutter and the axis.
+        for text in [
+            r#"{"type": "torus", "centre": [0,0,0], "axis": [0,1,1], "major_radius": 5, "minor_radius": 1}"#,
+            r#"{"type": "cylinder", "point": [0,0,0], "axis": [1,0,1], "radius": 1}"#,
+            r#"{"type": "cylinder", "point": [0,0,0], "axis": [1,0,1], "radius": 1, "length": [0, 5]}"#,
+            r#"{"type": "cylinder", "point": [0,0,0], "axis": [1,0,0], "radius": 1, "length": [0, 5]}"#,
+            r#"{"type": "cone", "apex": [0,0,0], "axis": [1,0,1], "half_angle": 20, "length": [1, 5]}"#,
+        ] {
+            let m = model(&format!(r#"{{"surfaces": [{text}]}}"#));
+            for c in CUTTERS {
+                for axis in [V3::z(), V3::new(0.3, -0.2, 1.0)] {
+                    assert!(DropCutter::new(&m, c, axis).is_ok(), "{text} {c:?}");
+                }
+            }
+        }
     }
 }

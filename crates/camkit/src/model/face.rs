@@ -429,12 +429,22 @@ impl Carrier {
     }
 
     /// The carrier's normal at a point on it.
-    fn normal_at(&self, p: &P3) -> V3 {
+    pub fn normal_at(&self, p: &P3) -> V3 {
         match self {
             Carrier::Analytic(a) => a.foot(p).normal,
             Carrier::Patch(s) => s.nearest(p, f64::INFINITY).expect("an unbounded query finds a point").0.normal,
         }
     }
+}
+
+/// True when the segment from `a` to `b` meets the rectangle [lo, hi].
+fn segment_meets_rect(a: [f64; 2], b: [f64; 2], lo: [f64; 2], hi: [f64; 2]) -> bool {
+    if a[0].max(b[0]) < lo[0] || a[0].min(b[0]) > hi[0] || a[1].max(b[1]) < lo[1] || a[1].min(b[1]) > hi[1] {
+        return false;
+    }
+    let side = |x: f64, y: f64| (b[0] - a[0]) * (y - a[1]) - (b[1] - a[1]) * (x - a[0]);
+    let s = [side(lo[0], lo[1]), side(hi[0], lo[1]), side(hi[0], hi[1]), side(lo[0], hi[1])];
+    !(s.iter().all(|&v| v > 0.0) || s.iter().all(|&v| v < 0.0))
 }
 
 /// Distance from `p` to the segment from `a` to `b`.
@@ -516,6 +526,37 @@ impl Face {
         self.bounds
     }
 
+    /// The (u, v) box [u0, u1, v0, v1] of the face: its loops', a whole turn of u where one
+    /// winds round it, out to a pole of a sphere the face holds.
+    pub fn uv_box(&self) -> [f64; 4] {
+        let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+        for (a, b) in self.loops.iter().flat_map(|l| l.segs.iter()) {
+            for p in [a, b] {
+                for c in 0..2 {
+                    lo[c] = lo[c].min(p[c]);
+                    hi[c] = hi[c].max(p[c]);
+                }
+            }
+        }
+        if self.loops.iter().any(|l| l.wraps != 0) {
+            hi[0] = lo[0] + TAU;
+            if let Carrier::Analytic(Analytic::Sphere { .. }) = self.carrier {
+                if self.inside([lo[0], -PI / 2.0]) {
+                    lo[1] = -PI / 2.0;
+                }
+                if self.inside([lo[0], PI / 2.0]) {
+                    hi[1] = PI / 2.0;
+                }
+            }
+        }
+        for c in 0..2 {
+            if self.carrier.periodic()[c] && hi[c] - lo[c] > TAU {
+                hi[c] = lo[c] + TAU;
+            }
+        }
+        [lo[0], hi[0], lo[1], hi[1]]
+    }
+
     /// The carrier.
     pub fn carrier(&self) -> &Carrier {
         &self.carrier
@@ -530,6 +571,37 @@ impl Face {
     /// The boundary curves of every loop.
     pub fn edges(&self) -> impl Iterator<Item = &Curve> {
         self.edges.iter().map(|(c, _)| c)
+    }
+
+    /// False when no loop passes within the tolerance of the rectangle [lo, hi] of (u, v) (moved
+    /// by whole turns along periodic parameters), so that it lies wholly inside or wholly outside
+    /// the face; true when one may.
+    pub fn crosses(&self, lo: [f64; 2], hi: [f64; 2]) -> bool {
+        let periodic = self.carrier.periodic();
+        let (lo, hi) = ([lo[0] - self.tol, lo[1] - self.tol], [hi[0] + self.tol, hi[1] + self.tol]);
+        for l in &self.loops {
+            let top = [0, 1].map(|c| l.origin[c] + l.cell[c] * GRID as f64);
+            let turns = |c: usize| -> Vec<f64> {
+                if !periodic[c] {
+                    return vec![0.0];
+                }
+                let first = ((l.origin[c] - hi[c]) / TAU).floor() as i64;
+                let last = ((top[c] - lo[c]) / TAU).ceil() as i64;
+                (first..=last).map(|k| k as f64 * TAU).collect()
+            };
+            for du in turns(0) {
+                for dv in turns(1) {
+                    let (a, b) = ([lo[0] + du, lo[1] + dv], [hi[0] + du, hi[1] + dv]);
+                    if a[0] > top[0] || a[1] > top[1] || b[0] < l.origin[0] || b[1] < l.origin[1] {
+                        continue;
+                    }
+                    if l.segs.iter().any(|(p, q)| segment_meets_rect(*p, *q, a, b)) {
+                        return true;
+                    }
+                }
+            }
+        }
+        false
     }
 
     /// True when (u, v) is inside the face or on its boundary.

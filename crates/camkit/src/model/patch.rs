@@ -4,6 +4,7 @@
 
 use super::analytic::Foot;
 use super::bvh::{Aabb, Bvh};
+use super::sheet::{Bezier, Map};
 use crate::doc::model::MAX_DEGREE;
 use crate::geom::{P3, V3};
 
@@ -153,6 +154,39 @@ pub(super) fn basis_derivs(knots: &[f64], s: usize, p: usize, t: f64) -> [[f64; 
     ders
 }
 
+/// Knots and control points (rows of any width, combined linearly) of the same spline with every
+/// knot of the domain inserted until it is at least `p`-fold.
+pub(super) fn bezier_knots(knots: &[f64], mut pts: Vec<Vec<f64>>, p: usize) -> (Vec<f64>, Vec<Vec<f64>>) {
+    let mut knots = knots.to_vec();
+    let (start, end) = (knots[p], knots[pts.len()]);
+    let mut values: Vec<f64> = knots.iter().copied().filter(|&t| t >= start && t <= end).collect();
+    values.dedup();
+    for t in values {
+        while knots.iter().filter(|&&k| k == t).count() < p {
+            // t in [U[k], U[k + 1]) (at the domain's end, in (U[k], U[k + 1]]).
+            let k = if t == end { knots.iter().rposition(|&x| x < t) } else { knots.iter().rposition(|&x| x <= t) }
+                .expect("a knot at or below one of the domain");
+            let mut next = Vec::with_capacity(pts.len() + 1);
+            next.extend(pts[..=k - p].iter().cloned());
+            for i in k + 1 - p..=k {
+                let a = (t - knots[i]) / (knots[i + p] - knots[i]);
+                next.push(pts[i].iter().zip(&pts[i - 1]).map(|(x, y)| a * x + (1.0 - a) * y).collect());
+            }
+            next.extend(pts[k..].iter().cloned());
+            knots.insert(k + 1, t);
+            pts = next;
+        }
+    }
+    (knots, pts)
+}
+
+/// The non-empty spans of a Bézier-form knot vector: the index of each one's last point and its
+/// ends.
+pub(super) fn bezier_spans(knots: &[f64], p: usize) -> Vec<(usize, f64, f64)> {
+    let n = knots.len() - p - 1;
+    (p..n).filter(|&k| knots[k] < knots[k + 1]).map(|k| (k, knots[k], knots[k + 1])).collect()
+}
+
 impl BSpline {
     /// A surface from a rectangular net (`net[i][j]`, i along u), degrees and knots (clamped
     /// uniform when `None`). The caller has validated sizes and knots.
@@ -255,6 +289,40 @@ impl BSpline {
         let suv = (acc[4] - su * wv - sv * wu - s * wuv) / w;
         let svv = (acc[5] - sv * (2.0 * wv) - s * wvv) / w;
         Derivs { s: P3::from(s), su, sv, suu, suv, svv }
+    }
+
+    /// The surface as rational Bézier patches, one per knot span, each mapping [0, 1]² onto its
+    /// span (knots inserted until every one in the domain is p- or q-fold: the NURBS Book, A5.1).
+    pub fn bezier_pieces(&self) -> Vec<Bezier> {
+        let [p, q] = self.degree;
+        let [nu, nv] = self.size;
+        let w = |k: usize| self.weights.as_ref().map_or(1.0, |ws| ws[k]);
+        let h = |k: usize| {
+            let c = self.ctrl[k] * w(k);
+            [c.x, c.y, c.z, w(k)]
+        };
+        // Along u: row i holds the homogeneous points of column i (4 nv numbers).
+        let rows: Vec<Vec<f64>> = (0..nu).map(|i| (0..nv).flat_map(|j| h(i * nv + j)).collect()).collect();
+        let (ku, rows) = bezier_knots(&self.knots[0], rows, p);
+        let nu = rows.len();
+        // Along v: row j holds the points of row j over every i.
+        let cols: Vec<Vec<f64>> =
+            (0..nv).map(|j| (0..nu).flat_map(|i| rows[i][4 * j..4 * j + 4].to_vec()).collect()).collect();
+        let (kv, cols) = bezier_knots(&self.knots[1], cols, q);
+        let mut out = Vec::new();
+        for (a, ua, ub) in bezier_spans(&ku, p) {
+            for (b, va, vb) in bezier_spans(&kv, q) {
+                let mut pts = Vec::with_capacity((p + 1) * (q + 1));
+                for i in a - p..=a {
+                    for col in &cols[b - q..=b] {
+                        let c = &col[4 * i..4 * i + 4];
+                        pts.push([c[0], c[1], c[2], c[3]]);
+                    }
+                }
+                out.push(Bezier::new([p, q], pts, [Map::Linear(ua, ub), Map::Linear(va, vb)]));
+            }
+        }
+        out
     }
 
     /// Unit normal Su × Sv at (u, v), if the surface is regular there.

@@ -25,7 +25,7 @@ pub fn style() -> Style {
 /// `nodes` × `nodes` nodes (2 to [`MAX_NODES`]), broken where nothing of the model is under a
 /// node or its top is above `ceiling`.
 pub fn height_grid(model: &Model, lo: [f64; 2], hi: [f64; 2], nodes: usize, ceiling: f64) -> Vec<(Vec<P3>, Style)> {
-    let dc = DropCutter::new(model, Cutter::Ball { radius: PROBE }, V3::z()).ok();
+    let dc = DropCutter::closed_forms(model, Cutter::Ball { radius: PROBE }, V3::z()).ok();
     let top = model.bounds().max.z;
     let top = if top.is_finite() { top } else { 0.0 };
     let n = nodes.clamp(2, MAX_NODES);
