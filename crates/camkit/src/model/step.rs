@@ -10,17 +10,18 @@ use super::analytic::Analytic;
 use super::face::{Carrier, Curve, Face, SplineCurve};
 use super::part21::{Exchange, Instance, Param};
 use super::patch::BSpline;
+use super::revolution::Revolution;
 use super::{Geometry, Surface};
 use crate::doc::model::MAX_DEGREE;
 use crate::error::{Error, Location, Result};
 use crate::geom::{P3, V3};
 use crate::io::Input;
 use nalgebra::{Isometry3, Matrix3, Rotation3, Translation3, UnitQuaternion};
+use std::collections::HashMap;
 use std::f64::consts::TAU;
 
 /// The surface entities read.
-const SURFACES: &str =
-    "PLANE, CYLINDRICAL_SURFACE, CONICAL_SURFACE, SPHERICAL_SURFACE, TOROIDAL_SURFACE, B_SPLINE_SURFACE_WITH_KNOTS";
+const SURFACES: &str = "PLANE, CYLINDRICAL_SURFACE, CONICAL_SURFACE, SPHERICAL_SURFACE, TOROIDAL_SURFACE, B_SPLINE_SURFACE_WITH_KNOTS, SURFACE_OF_REVOLUTION";
 
 /// The edge curve entities read.
 const CURVES: &str = "LINE, CIRCLE, ELLIPSE, B_SPLINE_CURVE_WITH_KNOTS (also as SURFACE_CURVE or SEAM_CURVE)";
@@ -97,9 +98,10 @@ pub fn load(input: &Input, skip: bool) -> Result<Vec<Surface>> {
         )
         .at(Location::file(&input.name)));
     }
+    let reversed = r.reversed().map_err(problem_error)?;
     let mut out = Vec::new();
     for id in faces {
-        match r.face(id) {
+        match r.face(id, reversed.get(&id).copied().unwrap_or(false)) {
             Ok(s) => out.push(s),
             Err(Problem::Unsupported(e)) if skip => crate::cli::warn(&format!("{e}; face #{id} left out")),
             Err(Problem::Unsupported(e)) => {
@@ -123,6 +125,44 @@ fn problem_error(p: Problem) -> Error {
 }
 
 impl Reader<'_> {
+    /// The faces turned over by the shells that hold them: an ORIENTED_FACE, or a face of an
+    /// ORIENTED_CLOSED_SHELL / ORIENTED_OPEN_SHELL (a BREP_WITH_VOIDS's void), with orientation
+    /// .F.; each turning toggles.
+    fn reversed(&self) -> Res<HashMap<usize, bool>> {
+        let mut out: HashMap<usize, bool> = HashMap::new();
+        let mut ids: Vec<usize> = self.ex.instances.keys().copied().collect();
+        ids.sort_unstable();
+        for id in ids {
+            let inst = self.get(id)?;
+            let face = |f: usize| -> Res<usize> {
+                match self.get(f)?.part("ORIENTED_FACE") {
+                    Some(p) => self.reference(f, p, 2),
+                    None => Ok(f),
+                }
+            };
+            if let Some(p) = inst.part("ORIENTED_FACE") {
+                if !self.boolean(id, p, 3)? {
+                    *out.entry(self.reference(id, p, 2)?).or_default() ^= true;
+                }
+            }
+            for kind in ["ORIENTED_CLOSED_SHELL", "ORIENTED_OPEN_SHELL"] {
+                let Some(p) = inst.part(kind) else { continue };
+                if self.boolean(id, p, 3)? {
+                    continue;
+                }
+                let shell = self.reference(id, p, 2)?;
+                let sh = self.get(shell)?;
+                let Some(sp) = sh.part("CLOSED_SHELL").or(sh.part("OPEN_SHELL")) else {
+                    return Err(self.invalid(shell, "expected CLOSED_SHELL or OPEN_SHELL"));
+                };
+                for f in self.refs(shell, self.list(shell, sp, 1)?)? {
+                    *out.entry(face(f)?).or_default() ^= true;
+                }
+            }
+        }
+        Ok(out)
+    }
+
     fn at(&self, id: usize) -> Location {
         let line = self.ex.instances.get(&id).map_or(0, |i| i.line);
         Location::file(self.file).line(line)
@@ -276,8 +316,8 @@ impl Reader<'_> {
         Ok(Isometry3::from_parts(Translation3::from(origin.coords), UnitQuaternion::from_rotation_matrix(&rot)))
     }
 
-    /// A face as a surface of the model.
-    fn face(&self, id: usize) -> Res<Surface> {
+    /// A face as a surface of the model; `reversed` when the shells that hold it turn it over.
+    fn face(&self, id: usize, reversed: bool) -> Res<Surface> {
         let p = self.part(id, "ADVANCED_FACE")?;
         let bounds = self.refs(id, self.list(id, p, 1)?)?;
         let sid = self.reference(id, p, 2)?;
@@ -285,9 +325,14 @@ impl Reader<'_> {
         let s = self.get(sid)?;
         let analytic = ["PLANE", "CYLINDRICAL_SURFACE", "CONICAL_SURFACE", "SPHERICAL_SURFACE", "TOROIDAL_SURFACE"];
         let kind = s.parts[0].0.as_str();
+        let mut profile = None;
         let placement = if s.parts.len() == 1 && analytic.contains(&kind) {
             let sp = &s.parts[0].1;
             Some(self.axis2(self.reference(sid, sp, 1)?)?)
+        } else if s.parts.len() == 1 && kind == "SURFACE_OF_REVOLUTION" {
+            let (iso, curve) = self.revolution(sid, id)?;
+            profile = Some(curve);
+            Some(iso)
         } else {
             None
         };
@@ -373,6 +418,7 @@ impl Reader<'_> {
                 minor: self.length(sid, sp, 3)?,
             }),
             _ if s.part("B_SPLINE_SURFACE_WITH_KNOTS").is_some() => Carrier::Patch(self.bspline_surface(sid)?),
+            _ if profile.is_some() => Carrier::Revolution(Revolution::new(profile.take().expect("a profile"))),
             _ => return Err(self.unsupported(sid, &format!("the surface of face #{id}"), SURFACES)),
         };
         let kind = match &carrier {
@@ -382,9 +428,54 @@ impl Reader<'_> {
             Carrier::Analytic(Analytic::Sphere { .. }) => "sphere",
             Carrier::Analytic(Analytic::Torus { .. }) => "torus",
             Carrier::Patch(_) => "bspline",
+            Carrier::Revolution(_) => "revolution",
         };
         let face = Face::new(carrier, loops, same_sense);
-        Ok(Surface::new(format!("{kind}#{id}"), Geometry::Face(Box::new(face)), placement, !same_sense))
+        Ok(Surface::new(format!("{kind}#{id}"), Geometry::Face(Box::new(face)), placement, same_sense == reversed))
+    }
+
+    /// A SURFACE_OF_REVOLUTION's frame (z its axis, x towards its swept curve) and the swept curve
+    /// in that frame, which must lie in the half-plane y = 0, x ≥ 0: a B-spline curve as it is,
+    /// a circle as the exact rational spline of four quarter arcs.
+    fn revolution(&self, sid: usize, face: usize) -> Res<(Isometry3<f64>, SplineCurve)> {
+        let sp = self.part(sid, "SURFACE_OF_REVOLUTION")?;
+        let (cid, aid) = (self.reference(sid, sp, 1)?, self.reference(sid, sp, 2)?);
+        let ap = self.part(aid, "AXIS1_PLACEMENT")?;
+        let origin = self.point(self.reference(aid, ap, 1)?)?;
+        let z = match ap.get(2) {
+            Some(Param::Ref(d)) => self.direction(*d)?,
+            _ => V3::z(),
+        };
+        let c = self.get(cid)?;
+        let curve = if c.parts.len() == 1 && c.parts[0].0 == "CIRCLE" {
+            let p = &c.parts[0].1;
+            let iso = self.axis2(self.reference(cid, p, 1)?)?;
+            let r = self.length(cid, p, 2)?;
+            let (x, y) = (iso * V3::x() * r, iso * V3::y() * r);
+            ellipse_from(iso * P3::origin(), x, y, iso * P3::new(r, 0.0, 0.0))
+        } else if c.part("B_SPLINE_CURVE_WITH_KNOTS").is_some() {
+            self.bspline_curve(cid)?
+        } else {
+            let read = "a B_SPLINE_CURVE_WITH_KNOTS or CIRCLE swept curve";
+            return Err(self.unsupported(cid, &format!("the swept curve of SURFACE_OF_REVOLUTION #{sid} of face #{face}"), read));
+        };
+        // x towards the control point farthest from the axis.
+        let radial = |p: &P3| (p - origin) - z * (p - origin).dot(&z);
+        let far = curve.ctrl.iter().map(radial).max_by(|a, b| a.norm().total_cmp(&b.norm())).unwrap_or(V3::zeros());
+        let x = far.try_normalize(1e-12).unwrap_or_else(|| super::analytic::any_perpendicular(&z));
+        let rot = Rotation3::from_matrix_unchecked(Matrix3::from_columns(&[x, z.cross(&x), z]));
+        let iso = Isometry3::from_parts(Translation3::from(origin.coords), UnitQuaternion::from_rotation_matrix(&rot));
+        let ctrl: Vec<P3> = curve.ctrl.iter().map(|p| iso.inverse_transform_point(p)).collect();
+        let tol = 1e-9 * (1.0 + far.norm());
+        if ctrl.iter().any(|p| p.y.abs() > tol || p.x < -tol) {
+            return Err(self.unsupported(
+                sid,
+                &format!("the surface of face #{face}, whose swept curve is not in a half-plane through the axis"),
+                "surfaces of revolution of plane profiles",
+            ));
+        }
+        let ctrl = ctrl.into_iter().map(|p| P3::new(p.x.max(0.0), 0.0, p.z)).collect();
+        Ok((iso, SplineCurve { ctrl, ..curve }))
     }
 
     /// A positive length parameter in mm.
@@ -658,7 +749,7 @@ mod tests {
         assert_eq!(e.exit_status(), 2);
         assert!(
             e.to_string()
-                .starts_with("t.stp:35: unsupported entity SURFACE_OF_REVOLUTION #80 (the surface of face #82)")
+                .starts_with("t.stp:20: unsupported entity LINE #50 (the swept curve of SURFACE_OF_REVOLUTION #80 of face #82)")
                 && e.to_string().ends_with("--skip-unsupported leaves such faces out"),
             "{e}"
         );
