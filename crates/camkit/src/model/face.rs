@@ -637,8 +637,8 @@ impl Face {
     /// Triangles covering the face (face frame, turned so that their right-hand normals follow
     /// the carrier's) and the largest distance found between them and the surface: a constrained
     /// Delaunay triangulation (`spade`) in (u, v) of the loops (as constraints, each segment
-    /// halved until the surface at its middle is within `chord` of its chord) and a 16 × 16 grid,
-    /// refined where the surface bends: every kept triangle whose plane is farther than `chord`
+    /// halved until the surface at its middle is within `chord` of its chord) and a grid as fine
+    /// each way as the surface bends that way, refined where the surface bends: every kept triangle whose plane is farther than `chord`
     /// from the surface at its edges' middles or its centroid gets a vertex at the worst of them,
     /// until none does or [`MAX_VERTICES`] are reached. The triangles whose middle is inside the
     /// face are kept; the boundary is the loops' polygon.
@@ -649,10 +649,31 @@ impl Face {
         let at = |q: [f64; 2]| self.carrier.point(q);
         let middle = |a: [f64; 2], b: [f64; 2]| [(a[0] + b[0]) / 2.0, (a[1] + b[1]) / 2.0];
         let mut cdt = ConstrainedDelaunayTriangulation::<Point2<f64>>::new();
-        let n = 16;
-        for i in 0..=n {
-            for j in 0..=n {
-                let f = [i as f64 / n as f64, j as f64 / n as f64];
+        // A start grid as fine each way as the surface bends that way (a cylinder's straight
+        // lines need no points along them): steps halved from 1/16 of the span until the surface
+        // midway between two grid points of nine lines across is within the chord of their chord.
+        let steps = |c: usize| {
+            let mut n = 16usize;
+            while n < 1 << 12 {
+                let bends = (0..=8).any(|j| {
+                    let across = lo[1 - c] + (hi[1 - c] - lo[1 - c]) * j as f64 / 8.0;
+                    let p = |i: f64| {
+                        let along = lo[c] + (hi[c] - lo[c]) * i / n as f64;
+                        at(if c == 0 { [along, across] } else { [across, along] })
+                    };
+                    (0..n).any(|i| (p(i as f64 + 0.5) - (p(i as f64) + p(i as f64 + 1.0).coords) / 2.0).norm() > chord)
+                });
+                if !bends {
+                    break;
+                }
+                n *= 2;
+            }
+            n
+        };
+        let (nu, nv) = (steps(0), steps(1));
+        for i in 0..=nu {
+            for j in 0..=nv {
+                let f = [i as f64 / nu as f64, j as f64 / nv as f64];
                 cdt.insert(Point2::new(lo[0] + (hi[0] - lo[0]) * f[0], lo[1] + (hi[1] - lo[1]) * f[1])).ok();
             }
         }
@@ -754,6 +775,14 @@ impl Face {
         }
         let mut best: Option<(P3, bool, f64)> = None;
         let mut limit = bound;
+        if let Carrier::Patch(s) = &self.carrier {
+            // A nearer local minimum inside the face than its edges (a B-spline bends back).
+            if let Some((f, _, c)) = s.nearest_where(q, bound, |uv| self.inside(uv)) {
+                let d = (f.point - q).norm();
+                limit = d;
+                best = Some((f.point, c, d));
+            }
+        }
         for (curve, b) in &self.edges {
             if b.dist2(q).sqrt() > limit {
                 continue;

@@ -290,11 +290,22 @@ impl BSpline {
     /// The nearest point to `q` no farther than `bound` (mm): foot, parameters and whether
     /// Newton converged there; `None` when the whole surface is farther than `bound`.
     pub fn nearest(&self, q: &P3, bound: f64) -> Option<(Foot, [f64; 2], bool)> {
+        self.nearest_where(q, bound, |_| true)
+    }
+
+    /// As [`BSpline::nearest`] over the spans' nearest points whose (u, v) `accept` takes: a
+    /// trimmed face's nearest interior point when the surface's own lies outside the face (a
+    /// span's nearest point, where it is accepted, is a point of the face no farther than any
+    /// other of that span's local minima that Newton reaches from the span's best sample).
+    pub fn nearest_where(&self, q: &P3, bound: f64, accept: impl Fn([f64; 2]) -> bool) -> Option<(Foot, [f64; 2], bool)> {
         let mut best: Option<(f64, [f64; 2], Derivs, bool)> = None;
         let bound2 = if bound.is_finite() { bound * bound } else { f64::INFINITY };
         self.index.nearest(q, bound2, |k, best2| {
             let (rect, span) = self.spans[k];
             let (uv, d, converged) = self.span_min(q, rect, span);
+            if !accept(uv) {
+                return f64::INFINITY;
+            }
             let e = (d.s - q).norm_squared();
             if e <= best2 && best.as_ref().is_none_or(|b| e < b.0) {
                 best = Some((e, uv, d, converged));

@@ -1,10 +1,12 @@
 //! STEP models (AP203, AP214, AP242 B-reps): every ADVANCED_FACE becomes a [`Face`] on camkit's
 //! exact surface of its kind (PLANE, CYLINDRICAL_SURFACE, CONICAL_SURFACE, SPHERICAL_SURFACE,
 //! TOROIDAL_SURFACE as analytic surfaces placed by their AXIS2_PLACEMENT_3D;
-//! B_SPLINE_SURFACE_WITH_KNOTS, rational or not, as a patch) trimmed by its loops (LINE, CIRCLE and
+//! B_SPLINE_SURFACE_WITH_KNOTS, rational or not, as a patch; SURFACE_OF_REVOLUTION of a B-spline
+//! or circle profile as a [`Revolution`]) trimmed by its loops (LINE, CIRCLE, ELLIPSE and
 //! B_SPLINE_CURVE_WITH_KNOTS edges, also under SURFACE_CURVE / SEAM_CURVE), in millimetres
-//! whatever the file's length unit. Any other surface or curve is an unsupported entity: an input
-//! error naming it and its `#id`, or with `skip` a warning and the face left out.
+//! whatever the file's length unit, its normal turned over by ORIENTED_FACE and oriented shells
+//! with orientation .F.. Any other surface or curve is an unsupported entity: an input error
+//! naming it and its `#id`, or with `skip` a warning and the face left out.
 
 use super::analytic::Analytic;
 use super::face::{Carrier, Curve, Face, SplineCurve};
@@ -686,6 +688,115 @@ mod tests {
         check(q, P3::new(8.0, 8.0, 20.0) + u * 8.0, u, "cylinder");
         check(P3::new(-5.0, 50.0, 20.0), P3::new(0.0, 50.0, 20.0), -V3::x(), "plane");
         check(P3::new(50.0, 50.0, -3.0), P3::new(50.0, 50.0, 0.0), -V3::z(), "plane");
+    }
+
+    fn data(name: &str) -> Model {
+        let path = format!("{}/../../data/step/{name}", env!("CARGO_MANIFEST_DIR"));
+        Model::load(&Input { name: name.into(), data: std::fs::read(path).unwrap() }).unwrap()
+    }
+
+    /// The point of the cubic Bézier profile of revolve.step at t, in (r, z): written out here,
+    /// apart from the reader's spline code.
+    fn knob_profile(t: f64) -> [f64; 2] {
+        let (r, z) = ([30.0, 33.0, 22.0, 25.0], [0.0, 5.0, 10.0, 15.0]);
+        let b = [(1.0 - t).powi(3), 3.0 * t * (1.0 - t).powi(2), 3.0 * t * t * (1.0 - t), t.powi(3)];
+        [(0..4).map(|i| b[i] * r[i]).sum(), (0..4).map(|i| b[i] * z[i]).sum()]
+    }
+
+    /// The knob of revolve.step: its two SURFACE_OF_REVOLUTION faces against the torus's closed
+    /// form (the swept exact quarter circle) and a dense search of the cubic profile, within
+    /// 0.1 µm, with the outward normal along q − foot.
+    #[test]
+    fn surfaces_of_revolution_against_closed_forms() {
+        let m = data("revolve.step");
+        let kinds: Vec<&str> = m.surfaces.iter().map(|s| s.name.split('#').next().unwrap()).collect();
+        assert_eq!(kinds.iter().filter(|k| **k == "revolution").count(), 2, "{kinds:?}");
+        assert_eq!(kinds.iter().filter(|k| **k == "plane").count(), 2, "{kinds:?}");
+        for (x, y, z) in [(24.0, 3.0, 18.0), (-15.0, 18.0, 21.0), (0.5, -27.0, 16.0), (19.0, -12.0, 19.5)] {
+            let q = P3::new(x, y, z);
+            let n = m.nearest(&q);
+            let rho: f64 = x.hypot(y);
+            let want = ((rho - 20.0).hypot(z - 15.0) - 5.0).abs();
+            assert!(m.surfaces[n.surface].name.starts_with("revolution"), "{q}: {}", m.surfaces[n.surface].name);
+            assert!((n.distance - want).abs() < 1e-7, "{q}: {} vs {want}", n.distance);
+            assert!((n.normal - n.direction(&q)).norm() < 1e-7, "{q}: normal {}", n.normal);
+        }
+        for (x, y, z) in [(33.0, 4.0, 5.0), (-20.0, -15.0, 8.0), (0.0, 28.0, 12.0), (24.0, 24.0, 2.0)] {
+            let q = P3::new(x, y, z);
+            let n = m.nearest(&q);
+            let rho: f64 = x.hypot(y);
+            let d = |t: f64| {
+                let [r, h] = knob_profile(t);
+                (r - rho).hypot(h - z)
+            };
+            // The densest sample, then golden sections on its neighbourhood.
+            let k: usize = 100_000;
+            let i = (0..=k).min_by(|a, b| d(*a as f64 / k as f64).total_cmp(&d(*b as f64 / k as f64))).unwrap();
+            let (mut a, mut b) = (i.saturating_sub(1) as f64 / k as f64, ((i + 1).min(k)) as f64 / k as f64);
+            for _ in 0..100 {
+                let (c, e) = (b - (b - a) * 0.618, a + (b - a) * 0.618);
+                if d(c) < d(e) { b = e } else { a = c }
+            }
+            let want = d(0.5 * (a + b));
+            assert!(m.surfaces[n.surface].name.starts_with("revolution"), "{q}: {}", m.surfaces[n.surface].name);
+            assert!((n.distance - want).abs() < 1e-7, "{q}: {} vs {want}", n.distance);
+            // Outward: along q − foot outside the knob, against it inside.
+            assert!(n.normal.cross(&n.direction(&q)).norm() < 1e-6, "{q}: normal {}", n.normal);
+            assert!(n.normal.z.abs() < 1.0 && n.normal.xy().dot(&q.coords.xy()) > 0.0, "{q}: normal {}", n.normal);
+        }
+        // Over the top disc.
+        let n = m.nearest(&P3::new(5.0, -6.0, 23.0));
+        assert!((n.point - P3::new(5.0, -6.0, 20.0)).norm() < 1e-12 && n.normal == V3::z(), "{}", n.point);
+    }
+
+    /// The closed periodic B-spline tube of tube.step is the cone r = 10 + z/6 (0 ≤ z ≤ 30): nearest
+    /// points on both sides of its seam (u = 0 on +x) and inside it against that closed form.
+    #[test]
+    fn closed_bspline_tube_against_its_cone() {
+        let m = data("tube.step");
+        assert_eq!(m.surfaces.len(), 1);
+        // Distance from (r, z) to the cone's generating segment (10, 0)–(15, 30).
+        let cone = |q: &P3| {
+            let (p, a, b) = ([q.x.hypot(q.y), q.z], [10.0, 0.0], [15.0, 30.0]);
+            let d = [b[0] - a[0], b[1] - a[1]];
+            let t = (((p[0] - a[0]) * d[0] + (p[1] - a[1]) * d[1]) / (d[0] * d[0] + d[1] * d[1])).clamp(0.0, 1.0);
+            (p[0] - a[0] - t * d[0]).hypot(p[1] - a[1] - t * d[1])
+        };
+        for (x, y, z) in [
+            (14.0, 0.01, 12.0),
+            (14.0, -0.01, 12.0),
+            (8.0, -1e-7, 20.0),
+            (9.0, 1e-7, 3.0),
+            (-3.0, 11.0, 25.0),
+            (0.0, -16.0, 4.0),
+            (2.0, 2.0, 15.0),
+            (13.0, 0.0, 33.0),
+        ] {
+            let q = P3::new(x, y, z);
+            let n = m.nearest(&q);
+            assert!((n.distance - cone(&q)).abs() < 1e-7, "{q}: {} vs {}", n.distance, cone(&q));
+            assert!(n.converged);
+        }
+    }
+
+    /// The void of void.step (an ORIENTED_CLOSED_SHELL .F. round a sphere face): its normal
+    /// points into the void, out of the material; the block's outside faces point out.
+    #[test]
+    fn a_reversed_shell_turns_its_faces_over() {
+        let m = data("void.step");
+        let centre = P3::new(30.0, 30.0, 20.0);
+        for q in [P3::new(30.0, 30.0, 22.0), P3::new(25.0, 33.0, 18.0), P3::new(30.0, 30.0, 28.0)] {
+            let n = m.nearest(&q);
+            let u = (q - centre).normalize();
+            assert!(m.surfaces[n.surface].name.starts_with("sphere"), "{}", m.surfaces[n.surface].name);
+            assert!((n.point - (centre + u * 10.0)).norm() < 1e-12, "{q}: {}", n.point);
+            assert!((n.normal + u).norm() < 1e-12, "{q}: normal {} should point into the void", n.normal);
+        }
+        let n = m.nearest(&P3::new(30.0, 30.0, 45.0));
+        assert!((n.point - P3::new(30.0, 30.0, 40.0)).norm() < 1e-12 && n.normal == V3::z());
+        // The sphere face, bounded by a vertex loop alone, is the whole sphere.
+        let n = m.nearest(&P3::new(30.0, 30.0, 15.0));
+        assert!((n.point - P3::new(30.0, 30.0, 10.0)).norm() < 1e-12, "{}", n.point);
     }
 
     fn step(body: &str) -> String {
