@@ -638,12 +638,17 @@ impl Face {
     /// the carrier's) and the largest distance found between them and the surface: a constrained
     /// Delaunay triangulation (`spade`) in (u, v) of the loops (as constraints, each segment
     /// halved until the surface at its middle is within `chord` of its chord) and a grid as fine
-    /// each way as the surface bends that way, refined where the surface bends: every kept triangle whose plane is farther than `chord`
+    /// each way as the surface bends that way, refined where the surface bends: every kept triangle whose plane is farther than 3/4 of `chord`
     /// from the surface at its edges' middles or its centroid gets a vertex at the worst of them,
-    /// until none does or [`MAX_VERTICES`] are reached. The triangles whose middle is inside the
+    /// until none does or [`MAX_VERTICES`] are reached; the distance returned is 4/3 of the largest
+    /// measured (to second order a triangle's distance is at most 4/3 of its edges' middles'). The triangles whose middle is inside the
     /// face are kept; the boundary is the loops' polygon.
     pub fn triangles(&self, chord: f64) -> (Vec<[P3; 3]>, f64) {
         use spade::{ConstrainedDelaunayTriangulation, Point2, Triangulation};
+        // A triangle's distance from a smooth surface is, to second order, a quadratic vanishing at
+        // its corners: 4 Σ m_ij λi λj over the edges' middles m_ij, at most 4/3 of the largest
+        // middle. Refining to 3/4 of the chord keeps the triangles within the chord.
+        let target = 0.75 * chord;
         let (lo, hi) = self.span();
         let extent = (hi[0] - lo[0]) * (hi[1] - lo[1]);
         let at = |q: [f64; 2]| self.carrier.point(q);
@@ -661,7 +666,7 @@ impl Face {
                         let along = lo[c] + (hi[c] - lo[c]) * i / n as f64;
                         at(if c == 0 { [along, across] } else { [across, along] })
                     };
-                    (0..n).any(|i| (p(i as f64 + 0.5) - (p(i as f64) + p(i as f64 + 1.0).coords) / 2.0).norm() > chord)
+                    (0..n).any(|i| (p(i as f64 + 0.5) - (p(i as f64) + p(i as f64 + 1.0).coords) / 2.0).norm() > target)
                 });
                 if !bends {
                     break;
@@ -692,7 +697,7 @@ impl Face {
                             (at(middle(p, q)) - (at(p) + at(q).coords) / 2.0).norm()
                         })
                         .fold(0.0, f64::max);
-                    if sag <= chord {
+                    if sag <= target {
                         break;
                     }
                     k *= 2;
@@ -720,7 +725,8 @@ impl Face {
                 if !self.inside(mid) {
                     continue;
                 }
-                let area = (uv[1][0] - uv[0][0]) * (uv[2][1] - uv[0][1]) - (uv[2][0] - uv[0][0]) * (uv[1][1] - uv[0][1]);
+                let area =
+                    (uv[1][0] - uv[0][0]) * (uv[2][1] - uv[0][1]) - (uv[2][0] - uv[0][0]) * (uv[1][1] - uv[0][1]);
                 if area <= 1e-14 * extent {
                     continue; // a sliver of a loop's nearly collinear points, turned either way in space
                 }
@@ -743,7 +749,7 @@ impl Face {
                     for (q, movable) in [(e, !fixed), (mid, true)] {
                         let d = ((at(q) - t[0]).dot(&nrm) / len).abs();
                         worst = worst.max(d);
-                        if movable && d > chord && bad.is_none_or(|(_, b)| d > b) {
+                        if movable && d > target && bad.is_none_or(|(_, b)| d > b) {
                             bad = Some((q, d));
                         }
                     }
@@ -753,15 +759,15 @@ impl Face {
                 }
                 tris.push(t);
             }
-            if worst <= chord || refine.is_empty() || cdt.num_vertices() >= MAX_VERTICES {
-                return (tris, worst);
+            if worst <= target || refine.is_empty() || cdt.num_vertices() >= MAX_VERTICES {
+                return (tris, worst * 4.0 / 3.0);
             }
             let before = cdt.num_vertices();
             for q in refine {
                 cdt.insert(Point2::new(q[0], q[1])).ok();
             }
             if cdt.num_vertices() == before {
-                return (tris, worst); // nothing new: the probes are vertices already
+                return (tris, worst * 4.0 / 3.0); // nothing new: the probes are vertices already
             }
         }
     }
@@ -952,7 +958,11 @@ mod tests {
             }
             // Turned with the carrier's normal (outward from the centre).
             let c = (t[0].coords + t[1].coords + t[2].coords) / 3.0;
-            assert!((t[1] - t[0]).cross(&(t[2] - t[0])).dot(&c) > 0.0, "{t:?} {}", (t[1] - t[0]).cross(&(t[2] - t[0])).norm());
+            assert!(
+                (t[1] - t[0]).cross(&(t[2] - t[0])).dot(&c) > 0.0,
+                "{t:?} {}",
+                (t[1] - t[0]).cross(&(t[2] - t[0])).norm()
+            );
         }
         // Together they cover the cap: 2πR(R − h) less the chord's shortfall.
         let area: f64 = tris.iter().map(|t| 0.5 * (t[1] - t[0]).cross(&(t[2] - t[0])).norm()).sum();

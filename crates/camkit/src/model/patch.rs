@@ -216,7 +216,11 @@ impl BSpline {
         let n = 4 * self.size[1 - c];
         (0..=n).all(|k| {
             let t = d[2 - 2 * c] + (d[3 - 2 * c] - d[2 - 2 * c]) * k as f64 / n as f64;
-            let (a, e) = if c == 0 { (self.eval(d[0], t), self.eval(d[1], t)) } else { (self.eval(t, d[2]), self.eval(t, d[3])) };
+            let (a, e) = if c == 0 {
+                (self.eval(d[0], t), self.eval(d[1], t))
+            } else {
+                (self.eval(t, d[2]), self.eval(t, d[3]))
+            };
             (a.s - e.s).norm() <= tol
         })
     }
@@ -297,7 +301,12 @@ impl BSpline {
     /// trimmed face's nearest interior point when the surface's own lies outside the face (a
     /// span's nearest point, where it is accepted, is a point of the face no farther than any
     /// other of that span's local minima that Newton reaches from the span's best sample).
-    pub fn nearest_where(&self, q: &P3, bound: f64, accept: impl Fn([f64; 2]) -> bool) -> Option<(Foot, [f64; 2], bool)> {
+    pub fn nearest_where(
+        &self,
+        q: &P3,
+        bound: f64,
+        accept: impl Fn([f64; 2]) -> bool,
+    ) -> Option<(Foot, [f64; 2], bool)> {
         let mut best: Option<(f64, [f64; 2], Derivs, bool)> = None;
         let bound2 = if bound.is_finite() { bound * bound } else { f64::INFINITY };
         self.index.nearest(q, bound2, |k, best2| {

@@ -82,7 +82,8 @@ impl Revolution {
         if (d.s - q).norm() > bound {
             return None;
         }
-        let normal = self.normal(u, v).unwrap_or_else(|| (q - d.s).try_normalize(crate::tol::LENGTH_EPS).unwrap_or(V3::z()));
+        let normal =
+            self.normal(u, v).unwrap_or_else(|| (q - d.s).try_normalize(crate::tol::LENGTH_EPS).unwrap_or(V3::z()));
         Some((Foot { point: d.s, normal }, [u, v], converged))
     }
 }

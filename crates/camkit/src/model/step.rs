@@ -459,7 +459,11 @@ impl Reader<'_> {
             self.bspline_curve(cid)?
         } else {
             let read = "a B_SPLINE_CURVE_WITH_KNOTS or CIRCLE swept curve";
-            return Err(self.unsupported(cid, &format!("the swept curve of SURFACE_OF_REVOLUTION #{sid} of face #{face}"), read));
+            return Err(self.unsupported(
+                cid,
+                &format!("the swept curve of SURFACE_OF_REVOLUTION #{sid} of face #{face}"),
+                read,
+            ));
         };
         // x towards the control point farthest from the axis.
         let radial = |p: &P3| (p - origin) - z * (p - origin).dot(&z);
@@ -859,9 +863,9 @@ mod tests {
         let e = load(&step(&square("SI_UNIT(.MILLI.,.METRE.)", revolved)), false).unwrap_err();
         assert_eq!(e.exit_status(), 2);
         assert!(
-            e.to_string()
-                .starts_with("t.stp:20: unsupported entity LINE #50 (the swept curve of SURFACE_OF_REVOLUTION #80 of face #82)")
-                && e.to_string().ends_with("--skip-unsupported leaves such faces out"),
+            e.to_string().starts_with(
+                "t.stp:20: unsupported entity LINE #50 (the swept curve of SURFACE_OF_REVOLUTION #80 of face #82)"
+            ) && e.to_string().ends_with("--skip-unsupported leaves such faces out"),
             "{e}"
         );
         let m = load(&step(&square("SI_UNIT(.MILLI.,.METRE.)", revolved)), true).unwrap();
