@@ -8,6 +8,16 @@
 #               minor 6) at (0, 60, 0); faces.json, the same surfaces as a camkit model document.
 # bspline.step: one face on a bicubic B-spline surface (natural boundary) and bspline.json, the
 #               same surface as a camkit model document (same control points and knots).
+# revolve.step: a knob turned about z: the disc z = 0 (r <= 30), a cubic B-spline profile from
+#               (30, 0) to (25, 15) (poles (30,0) (33,5) (22,10) (25,15) in (r, z)), an exact rational
+#               quarter circle of radius 5 about (20, 15) up to (20, 20), and the disc z = 20: FreeCAD
+#               writes both curved faces as SURFACE_OF_REVOLUTION of their B-spline profiles (the
+#               second is a torus exactly), each face's seam edge used twice.
+# tube.step:    one face on a closed periodic rational B-spline surface (u periodic: the exact circle
+#               of eight poles, weights 1 and 1/sqrt(2); v linear) from radius 10 at z = 0 to radius 15
+#               at z = 30: exactly the cone r = 10 + z / 6, its seam edge used twice.
+# void.step:    a 60 x 60 x 40 block with a spherical void R10 about (30, 30, 20): a BREP_WITH_VOIDS
+#               whose void is an ORIENTED_CLOSED_SHELL .F. (the sphere face turned over).
 # The control points are on a 0.5 mm grid and the knots are integers, so both files hold the
 # same numbers exactly.
 import json
@@ -57,3 +67,22 @@ doc = {"surfaces": [{"type": "bspline", "name": "free-form", "degree": [3, 3], "
 with open(os.path.join(out, "bspline.json"), "w") as f:
     json.dump(doc, f)
     f.write("\n")
+
+h = 0.5 ** 0.5
+cubic = Part.BSplineCurve()
+cubic.buildFromPolesMultsKnots([V(30, 0, 0), V(33, 0, 5), V(22, 0, 10), V(25, 0, 15)], [4, 4], [0.0, 1.0], False, 3)
+quarter = Part.BSplineCurve()
+quarter.buildFromPolesMultsKnots([V(25, 0, 15), V(25, 0, 20), V(20, 0, 20)], [3, 3], [0.0, 1.0], False, 2, [1.0, h, 1.0])
+profile = [Part.LineSegment(V(0, 0, 0), V(30, 0, 0)), cubic, quarter,
+           Part.LineSegment(V(20, 0, 20), V(0, 0, 20)), Part.LineSegment(V(0, 0, 20), V(0, 0, 0))]
+knob = Part.Face(Part.Wire([c.toShape() for c in profile])).revolve(V(0, 0, 0), V(0, 0, 1), 360)
+knob.exportStep(os.path.join(out, "revolve.step"))
+
+ring = [(1, 0), (1, 1), (0, 1), (-1, 1), (-1, 0), (-1, -1), (0, -1), (1, -1)]
+tube = Part.BSplineSurface()
+tube.buildFromPolesMultsKnots([[V(r * x, r * y, z) for (r, z) in [(10, 0), (15, 30)]] for (x, y) in ring],
+                              [2, 2, 2, 2, 2], [2, 2], [0.0, 1.0, 2.0, 3.0, 4.0], [0.0, 1.0], True, False, 2, 1,
+                              [[w, w] for w in [1, h] * 4])
+tube.toShape().exportStep(os.path.join(out, "tube.step"))
+
+Part.makeBox(60, 60, 40).cut(Part.makeSphere(10, V(30, 30, 20))).exportStep(os.path.join(out, "void.step"))

@@ -18,6 +18,7 @@
 use super::analytic::{Analytic, Foot};
 use super::bvh::Aabb;
 use super::patch::{BSpline, FOOT_TOL, basis_derivs, find_span};
+use super::revolution::Revolution;
 use crate::geom::{P3, V3};
 use std::f64::consts::{PI, TAU};
 
@@ -42,6 +43,8 @@ pub enum Carrier {
     Analytic(Analytic),
     /// A B-spline patch and its own parameters.
     Patch(BSpline),
+    /// A profile swept about the z axis; (u, v) is (angle about z, the profile's parameter).
+    Revolution(Revolution),
 }
 
 /// A B-spline (or NURBS) curve.
@@ -254,6 +257,8 @@ impl Curve {
 struct Loop {
     segs: Vec<([f64; 2], [f64; 2])>,
     wraps: i32,
+    /// Period of u (used when the loop winds).
+    period: f64,
     min: [f64; 2],
     /// First and last point (a winding loop is closed through v = +∞ from the last to the first).
     ends: [[f64; 2]; 2],
@@ -264,11 +269,14 @@ struct Loop {
     cells: Vec<Vec<u32>>,
 }
 
+/// Most vertices of one face's triangulation (some 200 bytes each while it is built).
+pub const MAX_VERTICES: usize = 2_000_000;
+
 /// Columns of u, and cells each way, per loop.
 const GRID: usize = 64;
 
 impl Loop {
-    fn new(uv: Vec<[f64; 2]>, wraps: i32, tol: f64) -> Loop {
+    fn new(uv: Vec<[f64; 2]>, wraps: i32, period: f64, tol: f64) -> Loop {
         let n = uv.len();
         let count = if wraps == 0 { n } else { n - 1 };
         let segs: Vec<_> = (0..count).map(|k| (uv[k], uv[(k + 1) % n])).collect();
@@ -290,7 +298,7 @@ impl Loop {
                 }
             }
         }
-        Loop { segs, wraps, min, ends: [uv[0], uv[n - 1]], origin, cell, columns, cells }
+        Loop { segs, wraps, period, min, ends: [uv[0], uv[n - 1]], origin, cell, columns, cells }
     }
 
     /// Index of `x` along coordinate `c` of the grid, if inside it.
@@ -325,9 +333,10 @@ impl Loop {
             // The rule counts a vertex of the ray's line at a segment's end for segments running
             // towards +u, at its start for those running towards −u: the loop's first point is
             // taken as its last.
-            p[0] = first[0] + TAU - (first[0] + TAU - p[0]).rem_euclid(TAU);
+            let t = self.period;
+            p[0] = first[0] + t - (first[0] + t - p[0]).rem_euclid(t);
         } else if self.wraps < 0 {
-            p[0] = first[0] - (first[0] - p[0]).rem_euclid(TAU);
+            p[0] = first[0] - (first[0] - p[0]).rem_euclid(self.period);
         }
         let mut w = 0;
         for (a, b) in self.column(p[0]) {
@@ -368,12 +377,22 @@ pub struct Face {
 }
 
 impl Carrier {
-    /// Which of (u, v) are angles.
-    fn periodic(&self) -> [bool; 2] {
+    /// The periods of (u, v) that are periodic: angles, and the parameters of B-spline patches
+    /// and profiles that close on themselves.
+    pub fn period(&self) -> [Option<f64>; 2] {
         match self {
-            Carrier::Analytic(Analytic::Plane { .. }) | Carrier::Patch(_) => [false, false],
-            Carrier::Analytic(Analytic::Torus { .. }) => [true, true],
-            Carrier::Analytic(_) => [true, false],
+            Carrier::Analytic(Analytic::Plane { .. }) => [None, None],
+            Carrier::Analytic(Analytic::Torus { .. }) => [Some(TAU), Some(TAU)],
+            Carrier::Analytic(_) => [Some(TAU), None],
+            Carrier::Patch(s) => {
+                let [u0, u1, v0, v1] = s.domain();
+                let c = s.closed();
+                [c[0].then_some(u1 - u0), c[1].then_some(v1 - v0)]
+            }
+            Carrier::Revolution(r) => {
+                let [_, _, v0, v1] = r.domain();
+                [Some(TAU), r.closed().then_some(v1 - v0)]
+            }
         }
     }
 
@@ -390,6 +409,10 @@ impl Carrier {
                 let (_, uv, _) = s.nearest(p, f64::INFINITY).expect("an unbounded query finds a point");
                 (Some(uv[0]), uv[1])
             }
+            Carrier::Revolution(r) => {
+                let (_, uv, _) = r.nearest(p, f64::INFINITY).expect("an unbounded query finds a point");
+                (u, uv[1])
+            }
         }
     }
 
@@ -405,6 +428,7 @@ impl Carrier {
                 Some((f, [u.unwrap_or(0.0), v], true))
             }
             Carrier::Patch(s) => s.nearest(q, bound),
+            Carrier::Revolution(r) => r.nearest(q, bound),
         }
     }
 
@@ -425,6 +449,7 @@ impl Carrier {
                 P3::new(rho * u.cos(), rho * u.sin(), minor * v.sin())
             }
             Carrier::Patch(s) => s.eval(u, v).s,
+            Carrier::Revolution(r) => r.eval(u, v).s,
         }
     }
 
@@ -433,6 +458,7 @@ impl Carrier {
         match self {
             Carrier::Analytic(a) => a.foot(p).normal,
             Carrier::Patch(s) => s.nearest(p, f64::INFINITY).expect("an unbounded query finds a point").0.normal,
+            Carrier::Revolution(r) => r.nearest(p, f64::INFINITY).expect("an unbounded query finds a point").0.normal,
         }
     }
 }
@@ -460,7 +486,7 @@ impl Face {
     /// walked in (true: from the curve's start to its end), oriented as STEP orients them for a
     /// face whose normal is the carrier's when `same_sense`.
     pub fn new(carrier: Carrier, loops: Vec<Vec<(Curve, bool)>>, same_sense: bool) -> Face {
-        let periodic = carrier.periodic();
+        let period = carrier.period();
         let straight = matches!(carrier, Carrier::Analytic(Analytic::Plane { .. } | Analytic::Cylinder { .. }));
         let mut polys = Vec::new();
         let mut edges = Vec::new();
@@ -494,17 +520,17 @@ impl Face {
             let mut uv: Vec<[f64; 2]> = pts.iter().map(|p| [p.0.unwrap_or(0.0), p.1]).collect();
             for i in 1..uv.len() {
                 for c in 0..2 {
-                    if periodic[c] {
+                    if let Some(t) = period[c] {
                         let prev = uv[i - 1][c];
-                        uv[i][c] = prev + (uv[i][c] - prev + PI).rem_euclid(TAU) - PI;
+                        uv[i][c] = prev + (uv[i][c] - prev + t / 2.0).rem_euclid(t) - t / 2.0;
                     }
                 }
             }
             // Closing the loop: how far it has wound round u.
             let last = uv[uv.len() - 1];
-            let wraps = if periodic[0] {
-                let closed = last[0] + (uv[0][0] - last[0] + PI).rem_euclid(TAU) - PI;
-                ((closed - uv[0][0]) / TAU).round() as i32
+            let wraps = if let Some(t) = period[0] {
+                let closed = last[0] + (uv[0][0] - last[0] + t / 2.0).rem_euclid(t) - t / 2.0;
+                ((closed - uv[0][0]) / t).round() as i32
             } else {
                 0
             };
@@ -512,11 +538,12 @@ impl Face {
         }
         let span = polys.iter().flat_map(|(uv, _)| uv.iter()).fold(0.0f64, |m, p| m.max(p[0].abs()).max(p[1].abs()));
         let tol = UV_TOL * (1.0 + span);
-        let polys = polys.into_iter().map(|(uv, wraps)| Loop::new(uv, wraps, tol)).collect();
+        let polys = polys.into_iter().map(|(uv, wraps)| Loop::new(uv, wraps, period[0].unwrap_or(TAU), tol)).collect();
         let bounds = match &carrier {
             Carrier::Analytic(Analytic::Plane { .. }) => extent,
             Carrier::Analytic(a) => a.bounds(),
             Carrier::Patch(s) => s.bounds(),
+            Carrier::Revolution(r) => r.bounds(),
         };
         Face { carrier, edges, loops: polys, sense: if same_sense { 1.0 } else { -1.0 }, tol, bounds }
     }
@@ -526,34 +553,10 @@ impl Face {
         self.bounds
     }
 
-    /// The (u, v) box [u0, u1, v0, v1] of the face: its loops', a whole turn of u where one
-    /// winds round it, out to a pole of a sphere the face holds.
+    /// The (u, v) box [u0, u1, v0, v1] the face spans (its loops', a full turn where one winds round,
+    /// out to a pole it holds; a vertex-bounded face's whole carrier).
     pub fn uv_box(&self) -> [f64; 4] {
-        let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
-        for (a, b) in self.loops.iter().flat_map(|l| l.segs.iter()) {
-            for p in [a, b] {
-                for c in 0..2 {
-                    lo[c] = lo[c].min(p[c]);
-                    hi[c] = hi[c].max(p[c]);
-                }
-            }
-        }
-        if self.loops.iter().any(|l| l.wraps != 0) {
-            hi[0] = lo[0] + TAU;
-            if let Carrier::Analytic(Analytic::Sphere { .. }) = self.carrier {
-                if self.inside([lo[0], -PI / 2.0]) {
-                    lo[1] = -PI / 2.0;
-                }
-                if self.inside([lo[0], PI / 2.0]) {
-                    hi[1] = PI / 2.0;
-                }
-            }
-        }
-        for c in 0..2 {
-            if self.carrier.periodic()[c] && hi[c] - lo[c] > TAU {
-                hi[c] = lo[c] + TAU;
-            }
-        }
+        let (lo, hi) = self.span();
         [lo[0], hi[0], lo[1], hi[1]]
     }
 
@@ -577,17 +580,15 @@ impl Face {
     /// by whole turns along periodic parameters), so that it lies wholly inside or wholly outside
     /// the face; true when one may.
     pub fn crosses(&self, lo: [f64; 2], hi: [f64; 2]) -> bool {
-        let periodic = self.carrier.periodic();
+        let period = self.carrier.period();
         let (lo, hi) = ([lo[0] - self.tol, lo[1] - self.tol], [hi[0] + self.tol, hi[1] + self.tol]);
         for l in &self.loops {
             let top = [0, 1].map(|c| l.origin[c] + l.cell[c] * GRID as f64);
             let turns = |c: usize| -> Vec<f64> {
-                if !periodic[c] {
-                    return vec![0.0];
-                }
-                let first = ((l.origin[c] - hi[c]) / TAU).floor() as i64;
-                let last = ((top[c] - lo[c]) / TAU).ceil() as i64;
-                (first..=last).map(|k| k as f64 * TAU).collect()
+                let Some(t) = period[c] else { return vec![0.0] };
+                let first = ((l.origin[c] - hi[c]) / t).floor() as i64;
+                let last = ((top[c] - lo[c]) / t).ceil() as i64;
+                (first..=last).map(|k| k as f64 * t).collect()
             };
             for du in turns(0) {
                 for dv in turns(1) {
@@ -606,18 +607,25 @@ impl Face {
 
     /// True when (u, v) is inside the face or on its boundary.
     pub fn inside(&self, uv: [f64; 2]) -> bool {
-        let periodic = self.carrier.periodic();
-        let shifts = |c: usize| if periodic[c] { &[0.0, -TAU, TAU][..] } else { &[0.0][..] };
+        if self.loops.is_empty() {
+            return true; // bounded by vertex loops alone: the whole carrier (a sphere)
+        }
+        let period = self.carrier.period();
+        let shifts = |c: usize| match period[c] {
+            Some(t) => ([0.0, -t, t], 3),
+            None => ([0.0; 3], 1),
+        };
+        let ((su, nu), (sv, nv)) = (shifts(0), shifts(1));
         let (mut w, mut wraps) = (0i32, 0i32);
         for l in &self.loops {
             let mut p = uv;
             for c in 0..2 {
-                if periodic[c] {
-                    p[c] = l.min[c] + (p[c] - l.min[c]).rem_euclid(TAU);
+                if let Some(t) = period[c] {
+                    p[c] = l.min[c] + (p[c] - l.min[c]).rem_euclid(t);
                 }
             }
-            for du in shifts(0) {
-                for dv in shifts(1) {
+            for du in &su[..nu] {
+                for dv in &sv[..nv] {
                     let q = [p[0] + du, p[1] + dv];
                     if l.touches(q, self.tol) {
                         return true;
@@ -631,14 +639,21 @@ impl Face {
         self.sense as i32 * w + below >= 1
     }
 
-    /// Triangles covering the face (face frame, turned so that their right-hand normals follow
-    /// the carrier's) and the largest distance found between them and the surface: a constrained
-    /// Delaunay triangulation (`spade`) in (u, v) of the loops (as constraints) and a grid of
-    /// points, the grid halved until that distance is below `chord` (at most 512 × 512); the
-    /// triangles whose middle is inside the face are kept. The boundary is the loops' polygon.
-    pub fn triangles(&self, chord: f64) -> (Vec<[P3; 3]>, f64) {
-        use spade::{ConstrainedDelaunayTriangulation, Point2, Triangulation};
-        let periodic = self.carrier.periodic();
+    /// The parameter rectangle the face spans: its loops' (a full turn where one winds round, out
+    /// to a pole the face holds), or the carrier's whole domain for a face bounded by vertex
+    /// loops alone (a whole sphere).
+    fn span(&self) -> ([f64; 2], [f64; 2]) {
+        let period = self.carrier.period();
+        if self.loops.is_empty() {
+            let [u0, u1, v0, v1] = match &self.carrier {
+                Carrier::Analytic(Analytic::Sphere { .. }) => [-PI, PI, -PI / 2.0, PI / 2.0],
+                Carrier::Analytic(Analytic::Torus { .. }) => [-PI, PI, -PI, PI],
+                Carrier::Patch(s) => s.domain(),
+                Carrier::Revolution(r) => r.domain(),
+                _ => [0.0; 4], // unbounded carriers always have loops
+            };
+            return ([u0, v0], [u1, v1]);
+        }
         let pts = || self.loops.iter().flat_map(|l| l.segs.iter().flat_map(|(a, b)| [*a, *b]));
         let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
         for p in pts() {
@@ -648,7 +663,7 @@ impl Face {
             }
         }
         if self.loops.iter().any(|l| l.wraps != 0) {
-            hi[0] = hi[0].max(lo[0] + TAU);
+            hi[0] = hi[0].max(lo[0] + period[0].unwrap_or(TAU));
             if let Carrier::Analytic(Analytic::Sphere { .. }) = self.carrier {
                 // Out to the pole the face holds.
                 if self.inside([lo[0], -PI / 2.0]) {
@@ -659,58 +674,147 @@ impl Face {
                 }
             }
         }
-        if periodic[1] && (hi[1] - lo[1]) > TAU {
-            hi[1] = lo[1] + TAU;
+        if let Some(t) = period[1] {
+            hi[1] = hi[1].min(lo[1] + t);
         }
-        let mut n = 16usize;
-        loop {
-            let mut cdt = ConstrainedDelaunayTriangulation::<Point2<f64>>::new();
-            let mut put = |p: [f64; 2]| cdt.insert(Point2::new(p[0], p[1])).ok();
-            for i in 0..=n {
-                for j in 0..=n {
-                    let f = [i as f64 / n as f64, j as f64 / n as f64];
-                    put([lo[0] + (hi[0] - lo[0]) * f[0], lo[1] + (hi[1] - lo[1]) * f[1]]);
+        (lo, hi)
+    }
+
+    /// Triangles covering the face (face frame, turned so that their right-hand normals follow
+    /// the carrier's) and the largest distance found between them and the surface: a constrained
+    /// Delaunay triangulation (`spade`) in (u, v) of the loops (as constraints, each segment
+    /// halved until the surface at its middle is within `chord` of its chord) and a grid as fine
+    /// each way as the surface bends that way, refined where the surface bends: every kept triangle whose plane is farther than 3/4 of `chord`
+    /// from the surface at its edges' middles or its centroid gets a vertex at the worst of them,
+    /// until none does or [`MAX_VERTICES`] are reached; the distance returned is 4/3 of the largest
+    /// measured (to second order a triangle's distance is at most 4/3 of its edges' middles'). The triangles whose middle is inside the
+    /// face are kept; the boundary is the loops' polygon.
+    pub fn triangles(&self, chord: f64) -> (Vec<[P3; 3]>, f64) {
+        use spade::{ConstrainedDelaunayTriangulation, Point2, Triangulation};
+        // A triangle's distance from a smooth surface is, to second order, a quadratic vanishing at
+        // its corners: 4 Σ m_ij λi λj over the edges' middles m_ij, at most 4/3 of the largest
+        // middle. Refining to 3/4 of the chord keeps the triangles within the chord.
+        let target = 0.75 * chord;
+        let (lo, hi) = self.span();
+        let extent = (hi[0] - lo[0]) * (hi[1] - lo[1]);
+        let at = |q: [f64; 2]| self.carrier.point(q);
+        let middle = |a: [f64; 2], b: [f64; 2]| [(a[0] + b[0]) / 2.0, (a[1] + b[1]) / 2.0];
+        let mut cdt = ConstrainedDelaunayTriangulation::<Point2<f64>>::new();
+        // A start grid as fine each way as the surface bends that way (a cylinder's straight
+        // lines need no points along them): steps halved from 1/16 of the span until the surface
+        // midway between two grid points of nine lines across is within the chord of their chord.
+        let steps = |c: usize| {
+            let mut n = 16usize;
+            while n < 1 << 12 {
+                let bends = (0..=8).any(|j| {
+                    let across = lo[1 - c] + (hi[1 - c] - lo[1 - c]) * j as f64 / 8.0;
+                    let p = |i: f64| {
+                        let along = lo[c] + (hi[c] - lo[c]) * i / n as f64;
+                        at(if c == 0 { [along, across] } else { [across, along] })
+                    };
+                    (0..n).any(|i| (p(i as f64 + 0.5) - (p(i as f64) + p(i as f64 + 1.0).coords) / 2.0).norm() > target)
+                });
+                if !bends {
+                    break;
                 }
+                n *= 2;
             }
-            let mut constraints = Vec::new();
-            for l in &self.loops {
-                for (a, b) in &l.segs {
-                    if let (Some(a), Some(b)) = (put(*a), put(*b)) {
-                        constraints.push((a, b));
+            n
+        };
+        let (nu, nv) = (steps(0), steps(1));
+        for i in 0..=nu {
+            for j in 0..=nv {
+                let f = [i as f64 / nu as f64, j as f64 / nv as f64];
+                cdt.insert(Point2::new(lo[0] + (hi[0] - lo[0]) * f[0], lo[1] + (hi[1] - lo[1]) * f[1])).ok();
+            }
+        }
+        for l in &self.loops {
+            for &(a, b) in &l.segs {
+                // Halved until every piece's middle is within the chord of the piece.
+                let mut k = 1usize;
+                while k < 1 << 12 {
+                    let piece = |i: usize| {
+                        let f = |t: f64| [a[0] + (b[0] - a[0]) * t, a[1] + (b[1] - a[1]) * t];
+                        (f(i as f64 / k as f64), f((i + 1) as f64 / k as f64))
+                    };
+                    let sag = (0..k)
+                        .map(|i| {
+                            let (p, q) = piece(i);
+                            (at(middle(p, q)) - (at(p) + at(q).coords) / 2.0).norm()
+                        })
+                        .fold(0.0, f64::max);
+                    if sag <= target {
+                        break;
                     }
+                    k *= 2;
+                }
+                let mut prev = cdt.insert(Point2::new(a[0], a[1])).ok();
+                for i in 1..=k {
+                    let t = i as f64 / k as f64;
+                    let next = cdt.insert(Point2::new(a[0] + (b[0] - a[0]) * t, a[1] + (b[1] - a[1]) * t)).ok();
+                    if let (Some(p), Some(q)) = (prev, next) {
+                        if p != q {
+                            cdt.try_add_constraint(p, q);
+                        }
+                    }
+                    prev = next;
                 }
             }
-            for (a, b) in constraints {
-                if a != b {
-                    cdt.try_add_constraint(a, b);
-                }
-            }
+        }
+        loop {
             let mut tris = Vec::new();
             let mut worst = 0.0f64;
+            let mut refine = Vec::new();
             for f in cdt.inner_faces() {
                 let uv = f.vertices().map(|v| [v.position().x, v.position().y]);
                 let mid = [(uv[0][0] + uv[1][0] + uv[2][0]) / 3.0, (uv[0][1] + uv[1][1] + uv[2][1]) / 3.0];
                 if !self.inside(mid) {
                     continue;
                 }
-                let t = uv.map(|q| self.carrier.point(q));
+                let area =
+                    (uv[1][0] - uv[0][0]) * (uv[2][1] - uv[0][1]) - (uv[2][0] - uv[0][0]) * (uv[1][1] - uv[0][1]);
+                if area <= 1e-14 * extent {
+                    continue; // a sliver of a loop's nearly collinear points, turned either way in space
+                }
+                let t = uv.map(at);
                 let nrm = (t[1] - t[0]).cross(&(t[2] - t[0]));
                 let len = nrm.norm();
                 if len <= 1e-12 {
                     continue; // collapsed at a pole or an apex
                 }
+                let edges = f.adjacent_edges();
+                let mut bad: Option<([f64; 2], f64)> = None;
                 for k in 0..3 {
-                    let e = [(uv[k][0] + uv[(k + 1) % 3][0]) / 2.0, (uv[k][1] + uv[(k + 1) % 3][1]) / 2.0];
-                    for q in [e, mid] {
-                        worst = worst.max(((self.carrier.point(q) - t[0]).dot(&nrm) / len).abs());
+                    let e = middle(uv[k], uv[(k + 1) % 3]);
+                    // Constraint edges were split to the chord beforehand: their middles stay.
+                    let fixed = edges.iter().any(|h| {
+                        let [p, q] = h.positions();
+                        let m = [(p.x + q.x) / 2.0, (p.y + q.y) / 2.0];
+                        m == e && cdt.is_constraint_edge(h.as_undirected().fix())
+                    });
+                    for (q, movable) in [(e, !fixed), (mid, true)] {
+                        let d = ((at(q) - t[0]).dot(&nrm) / len).abs();
+                        worst = worst.max(d);
+                        if movable && d > target && bad.is_none_or(|(_, b)| d > b) {
+                            bad = Some((q, d));
+                        }
                     }
+                }
+                if let Some((q, _)) = bad {
+                    refine.push(q);
                 }
                 tris.push(t);
             }
-            if worst <= chord || n >= 512 {
-                return (tris, worst);
+            if worst <= target || refine.is_empty() || cdt.num_vertices() >= MAX_VERTICES {
+                return (tris, worst * 4.0 / 3.0);
             }
-            n *= 2;
+            let before = cdt.num_vertices();
+            for q in refine {
+                cdt.insert(Point2::new(q[0], q[1])).ok();
+            }
+            if cdt.num_vertices() == before {
+                return (tris, worst * 4.0 / 3.0); // nothing new: the probes are vertices already
+            }
         }
     }
 
@@ -723,6 +827,14 @@ impl Face {
         }
         let mut best: Option<(P3, bool, f64)> = None;
         let mut limit = bound;
+        if let Carrier::Patch(s) = &self.carrier {
+            // A nearer local minimum inside the face than its edges (a B-spline bends back).
+            if let Some((f, _, c)) = s.nearest_where(q, bound, |uv| self.inside(uv)) {
+                let d = (f.point - q).norm();
+                limit = d;
+                best = Some((f.point, c, d));
+            }
+        }
         for (curve, b) in &self.edges {
             if b.dist2(q).sqrt() > limit {
                 continue;
@@ -892,7 +1004,11 @@ mod tests {
             }
             // Turned with the carrier's normal (outward from the centre).
             let c = (t[0].coords + t[1].coords + t[2].coords) / 3.0;
-            assert!((t[1] - t[0]).cross(&(t[2] - t[0])).dot(&c) > 0.0);
+            assert!(
+                (t[1] - t[0]).cross(&(t[2] - t[0])).dot(&c) > 0.0,
+                "{t:?} {}",
+                (t[1] - t[0]).cross(&(t[2] - t[0])).norm()
+            );
         }
         // Together they cover the cap: 2πR(R − h) less the chord's shortfall.
         let area: f64 = tris.iter().map(|t| 0.5 * (t[1] - t[0]).cross(&(t[2] - t[0])).norm()).sum();

@@ -19,6 +19,7 @@ pub mod face;
 pub mod mesh;
 pub mod part21;
 pub mod patch;
+pub mod revolution;
 pub mod sheet;
 pub mod step;
 

@@ -32,6 +32,8 @@ pub struct BSpline {
     /// Parameter rectangles of the spans, in the index's order: (u0, u1, v0, v1, span_u, span_v).
     spans: Vec<([f64; 4], [usize; 2])>,
     index: Bvh,
+    /// Whether the surface closes on itself in u and in v (a tube's seam).
+    closed: [bool; 2],
 }
 
 /// Point and derivatives up to second order at (u, v).
@@ -234,7 +236,33 @@ impl BSpline {
         }
         let index = Bvh::build(&boxes);
         let spans = index.order.iter().map(|&i| spans[i as usize]).collect();
-        BSpline { degree, size, ctrl, weights, knots, spans, index }
+        let mut s = BSpline { degree, size, ctrl, weights, knots, spans, index, closed: [false; 2] };
+        s.closed = [0, 1].map(|c| s.closes(c));
+        s
+    }
+
+    /// True when the boundary curves at both ends of parameter `c` coincide (checked at four
+    /// points per control point of the other direction, to 1e-9 of the surface's size).
+    fn closes(&self, c: usize) -> bool {
+        let d = self.domain();
+        let b = self.bounds();
+        let tol = 1e-9 * (1.0 + (b.max - b.min).norm().min(1e12) + b.max.coords.norm().min(1e12));
+        let n = 4 * self.size[1 - c];
+        (0..=n).all(|k| {
+            let t = d[2 - 2 * c] + (d[3 - 2 * c] - d[2 - 2 * c]) * k as f64 / n as f64;
+            let (a, e) = if c == 0 {
+                (self.eval(d[0], t), self.eval(d[1], t))
+            } else {
+                (self.eval(t, d[2]), self.eval(t, d[3]))
+            };
+            (a.s - e.s).norm() <= tol
+        })
+    }
+
+    /// Whether the surface closes on itself in u and in v: the parameter is then periodic in the
+    /// face reader's inside test.
+    pub fn closed(&self) -> [bool; 2] {
+        self.closed
     }
 
     /// Parameter domain [u0, u1, v0, v1].
@@ -334,11 +362,27 @@ impl BSpline {
     /// The nearest point to `q` no farther than `bound` (mm): foot, parameters and whether
     /// Newton converged there; `None` when the whole surface is farther than `bound`.
     pub fn nearest(&self, q: &P3, bound: f64) -> Option<(Foot, [f64; 2], bool)> {
+        self.nearest_where(q, bound, |_| true)
+    }
+
+    /// As [`BSpline::nearest`] over the spans' nearest points whose (u, v) `accept` takes: a
+    /// trimmed face's nearest interior point when the surface's own lies outside the face (a
+    /// span's nearest point, where it is accepted, is a point of the face no farther than any
+    /// other of that span's local minima that Newton reaches from the span's best sample).
+    pub fn nearest_where(
+        &self,
+        q: &P3,
+        bound: f64,
+        accept: impl Fn([f64; 2]) -> bool,
+    ) -> Option<(Foot, [f64; 2], bool)> {
         let mut best: Option<(f64, [f64; 2], Derivs, bool)> = None;
         let bound2 = if bound.is_finite() { bound * bound } else { f64::INFINITY };
         self.index.nearest(q, bound2, |k, best2| {
             let (rect, span) = self.spans[k];
             let (uv, d, converged) = self.span_min(q, rect, span);
+            if !accept(uv) {
+                return f64::INFINITY;
+            }
             let e = (d.s - q).norm_squared();
             if e <= best2 && best.as_ref().is_none_or(|b| e < b.0) {
                 best = Some((e, uv, d, converged));

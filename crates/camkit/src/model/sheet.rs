@@ -20,7 +20,8 @@
 use super::analytic::Analytic;
 use super::bvh::Aabb;
 use super::cutter::{Cutter, Plane, Touch};
-use super::face::{Carrier, Curve, Face};
+use super::face::{Carrier, Curve, Face, SplineCurve};
+use super::patch::{bezier_knots, bezier_spans};
 use crate::geom::{P3, V3};
 use nalgebra::Isometry3;
 use std::cmp::Ordering;
@@ -768,7 +769,21 @@ pub fn face_pieces(face: &Face) -> Vec<Bezier> {
         }
         Carrier::Analytic(Analytic::Sphere { radius, .. }) => revolve(&circle(0.0, *radius, v0, v1), u0, u1),
         Carrier::Analytic(Analytic::Torus { major, minor, .. }) => revolve(&circle(*major, *minor, v0, v1), u0, u1),
+        Carrier::Revolution(r) => revolve(&spline_section(r.profile()), u0, u1),
     }
+}
+
+/// A profile curve in the half-plane y = 0 (x the distance from the axis) as a section: its
+/// rational Bézier pieces between knots, mapped linearly onto the curve's own parameter.
+fn spline_section(c: &SplineCurve) -> Profile {
+    let p = c.degree;
+    let w = |i: usize| c.weights.as_ref().map_or(1.0, |ws| ws[i]);
+    let rows = c.ctrl.iter().enumerate().map(|(i, q)| vec![q.x * w(i), q.z * w(i), w(i)]).collect();
+    let (knots, pts) = bezier_knots(&c.knots, rows, p);
+    bezier_spans(&knots, p)
+        .into_iter()
+        .map(|(k, a, b)| ((k - p..=k).map(|i| [pts[i][0], pts[i][1], pts[i][2]]).collect(), Map::Linear(a, b)))
+        .collect()
 }
 
 /// A finite cylinder or cone, or a torus, as exact rational patches (its own frame); `None` for

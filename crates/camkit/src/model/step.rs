@@ -1,26 +1,29 @@
 //! STEP models (AP203, AP214, AP242 B-reps): every ADVANCED_FACE becomes a [`Face`] on camkit's
 //! exact surface of its kind (PLANE, CYLINDRICAL_SURFACE, CONICAL_SURFACE, SPHERICAL_SURFACE,
 //! TOROIDAL_SURFACE as analytic surfaces placed by their AXIS2_PLACEMENT_3D;
-//! B_SPLINE_SURFACE_WITH_KNOTS, rational or not, as a patch) trimmed by its loops (LINE, CIRCLE and
+//! B_SPLINE_SURFACE_WITH_KNOTS, rational or not, as a patch; SURFACE_OF_REVOLUTION of a B-spline
+//! or circle profile as a [`Revolution`]) trimmed by its loops (LINE, CIRCLE, ELLIPSE and
 //! B_SPLINE_CURVE_WITH_KNOTS edges, also under SURFACE_CURVE / SEAM_CURVE), in millimetres
-//! whatever the file's length unit. Any other surface or curve is an unsupported entity: an input
-//! error naming it and its `#id`, or with `skip` a warning and the face left out.
+//! whatever the file's length unit, its normal turned over by ORIENTED_FACE and oriented shells
+//! with orientation .F.. Any other surface or curve is an unsupported entity: an input error
+//! naming it and its `#id`, or with `skip` a warning and the face left out.
 
 use super::analytic::Analytic;
 use super::face::{Carrier, Curve, Face, SplineCurve};
 use super::part21::{Exchange, Instance, Param};
 use super::patch::BSpline;
+use super::revolution::Revolution;
 use super::{Geometry, Surface};
 use crate::doc::model::MAX_DEGREE;
 use crate::error::{Error, Location, Result};
 use crate::geom::{P3, V3};
 use crate::io::Input;
 use nalgebra::{Isometry3, Matrix3, Rotation3, Translation3, UnitQuaternion};
+use std::collections::HashMap;
 use std::f64::consts::TAU;
 
 /// The surface entities read.
-const SURFACES: &str =
-    "PLANE, CYLINDRICAL_SURFACE, CONICAL_SURFACE, SPHERICAL_SURFACE, TOROIDAL_SURFACE, B_SPLINE_SURFACE_WITH_KNOTS";
+const SURFACES: &str = "PLANE, CYLINDRICAL_SURFACE, CONICAL_SURFACE, SPHERICAL_SURFACE, TOROIDAL_SURFACE, B_SPLINE_SURFACE_WITH_KNOTS, SURFACE_OF_REVOLUTION";
 
 /// The edge curve entities read.
 const CURVES: &str = "LINE, CIRCLE, ELLIPSE, B_SPLINE_CURVE_WITH_KNOTS (also as SURFACE_CURVE or SEAM_CURVE)";
@@ -97,9 +100,10 @@ pub fn load(input: &Input, skip: bool) -> Result<Vec<Surface>> {
         )
         .at(Location::file(&input.name)));
     }
+    let reversed = r.reversed().map_err(problem_error)?;
     let mut out = Vec::new();
     for id in faces {
-        match r.face(id) {
+        match r.face(id, reversed.get(&id).copied().unwrap_or(false)) {
             Ok(s) => out.push(s),
             Err(Problem::Unsupported(e)) if skip => crate::cli::warn(&format!("{e}; face #{id} left out")),
             Err(Problem::Unsupported(e)) => {
@@ -123,6 +127,44 @@ fn problem_error(p: Problem) -> Error {
 }
 
 impl Reader<'_> {
+    /// The faces turned over by the shells that hold them: an ORIENTED_FACE, or a face of an
+    /// ORIENTED_CLOSED_SHELL / ORIENTED_OPEN_SHELL (a BREP_WITH_VOIDS's void), with orientation
+    /// .F.; each turning toggles.
+    fn reversed(&self) -> Res<HashMap<usize, bool>> {
+        let mut out: HashMap<usize, bool> = HashMap::new();
+        let mut ids: Vec<usize> = self.ex.instances.keys().copied().collect();
+        ids.sort_unstable();
+        for id in ids {
+            let inst = self.get(id)?;
+            let face = |f: usize| -> Res<usize> {
+                match self.get(f)?.part("ORIENTED_FACE") {
+                    Some(p) => self.reference(f, p, 2),
+                    None => Ok(f),
+                }
+            };
+            if let Some(p) = inst.part("ORIENTED_FACE") {
+                if !self.boolean(id, p, 3)? {
+                    *out.entry(self.reference(id, p, 2)?).or_default() ^= true;
+                }
+            }
+            for kind in ["ORIENTED_CLOSED_SHELL", "ORIENTED_OPEN_SHELL"] {
+                let Some(p) = inst.part(kind) else { continue };
+                if self.boolean(id, p, 3)? {
+                    continue;
+                }
+                let shell = self.reference(id, p, 2)?;
+                let sh = self.get(shell)?;
+                let Some(sp) = sh.part("CLOSED_SHELL").or(sh.part("OPEN_SHELL")) else {
+                    return Err(self.invalid(shell, "expected CLOSED_SHELL or OPEN_SHELL"));
+                };
+                for f in self.refs(shell, self.list(shell, sp, 1)?)? {
+                    *out.entry(face(f)?).or_default() ^= true;
+                }
+            }
+        }
+        Ok(out)
+    }
+
     fn at(&self, id: usize) -> Location {
         let line = self.ex.instances.get(&id).map_or(0, |i| i.line);
         Location::file(self.file).line(line)
@@ -276,8 +318,8 @@ impl Reader<'_> {
         Ok(Isometry3::from_parts(Translation3::from(origin.coords), UnitQuaternion::from_rotation_matrix(&rot)))
     }
 
-    /// A face as a surface of the model.
-    fn face(&self, id: usize) -> Res<Surface> {
+    /// A face as a surface of the model; `reversed` when the shells that hold it turn it over.
+    fn face(&self, id: usize, reversed: bool) -> Res<Surface> {
         let p = self.part(id, "ADVANCED_FACE")?;
         let bounds = self.refs(id, self.list(id, p, 1)?)?;
         let sid = self.reference(id, p, 2)?;
@@ -285,9 +327,14 @@ impl Reader<'_> {
         let s = self.get(sid)?;
         let analytic = ["PLANE", "CYLINDRICAL_SURFACE", "CONICAL_SURFACE", "SPHERICAL_SURFACE", "TOROIDAL_SURFACE"];
         let kind = s.parts[0].0.as_str();
+        let mut profile = None;
         let placement = if s.parts.len() == 1 && analytic.contains(&kind) {
             let sp = &s.parts[0].1;
             Some(self.axis2(self.reference(sid, sp, 1)?)?)
+        } else if s.parts.len() == 1 && kind == "SURFACE_OF_REVOLUTION" {
+            let (iso, curve) = self.revolution(sid, id)?;
+            profile = Some(curve);
+            Some(iso)
         } else {
             None
         };
@@ -373,6 +420,7 @@ impl Reader<'_> {
                 minor: self.length(sid, sp, 3)?,
             }),
             _ if s.part("B_SPLINE_SURFACE_WITH_KNOTS").is_some() => Carrier::Patch(self.bspline_surface(sid)?),
+            _ if profile.is_some() => Carrier::Revolution(Revolution::new(profile.take().expect("a profile"))),
             _ => return Err(self.unsupported(sid, &format!("the surface of face #{id}"), SURFACES)),
         };
         let kind = match &carrier {
@@ -382,9 +430,58 @@ impl Reader<'_> {
             Carrier::Analytic(Analytic::Sphere { .. }) => "sphere",
             Carrier::Analytic(Analytic::Torus { .. }) => "torus",
             Carrier::Patch(_) => "bspline",
+            Carrier::Revolution(_) => "revolution",
         };
         let face = Face::new(carrier, loops, same_sense);
-        Ok(Surface::new(format!("{kind}#{id}"), Geometry::Face(Box::new(face)), placement, !same_sense))
+        Ok(Surface::new(format!("{kind}#{id}"), Geometry::Face(Box::new(face)), placement, same_sense == reversed))
+    }
+
+    /// A SURFACE_OF_REVOLUTION's frame (z its axis, x towards its swept curve) and the swept curve
+    /// in that frame, which must lie in the half-plane y = 0, x ≥ 0: a B-spline curve as it is,
+    /// a circle as the exact rational spline of four quarter arcs.
+    fn revolution(&self, sid: usize, face: usize) -> Res<(Isometry3<f64>, SplineCurve)> {
+        let sp = self.part(sid, "SURFACE_OF_REVOLUTION")?;
+        let (cid, aid) = (self.reference(sid, sp, 1)?, self.reference(sid, sp, 2)?);
+        let ap = self.part(aid, "AXIS1_PLACEMENT")?;
+        let origin = self.point(self.reference(aid, ap, 1)?)?;
+        let z = match ap.get(2) {
+            Some(Param::Ref(d)) => self.direction(*d)?,
+            _ => V3::z(),
+        };
+        let c = self.get(cid)?;
+        let curve = if c.parts.len() == 1 && c.parts[0].0 == "CIRCLE" {
+            let p = &c.parts[0].1;
+            let iso = self.axis2(self.reference(cid, p, 1)?)?;
+            let r = self.length(cid, p, 2)?;
+            let (x, y) = (iso * V3::x() * r, iso * V3::y() * r);
+            ellipse_from(iso * P3::origin(), x, y, iso * P3::new(r, 0.0, 0.0))
+        } else if c.part("B_SPLINE_CURVE_WITH_KNOTS").is_some() {
+            self.bspline_curve(cid)?
+        } else {
+            let read = "a B_SPLINE_CURVE_WITH_KNOTS or CIRCLE swept curve";
+            return Err(self.unsupported(
+                cid,
+                &format!("the swept curve of SURFACE_OF_REVOLUTION #{sid} of face #{face}"),
+                read,
+            ));
+        };
+        // x towards the control point farthest from the axis.
+        let radial = |p: &P3| (p - origin) - z * (p - origin).dot(&z);
+        let far = curve.ctrl.iter().map(radial).max_by(|a, b| a.norm().total_cmp(&b.norm())).unwrap_or(V3::zeros());
+        let x = far.try_normalize(1e-12).unwrap_or_else(|| super::analytic::any_perpendicular(&z));
+        let rot = Rotation3::from_matrix_unchecked(Matrix3::from_columns(&[x, z.cross(&x), z]));
+        let iso = Isometry3::from_parts(Translation3::from(origin.coords), UnitQuaternion::from_rotation_matrix(&rot));
+        let ctrl: Vec<P3> = curve.ctrl.iter().map(|p| iso.inverse_transform_point(p)).collect();
+        let tol = 1e-9 * (1.0 + far.norm());
+        if ctrl.iter().any(|p| p.y.abs() > tol || p.x < -tol) {
+            return Err(self.unsupported(
+                sid,
+                &format!("the surface of face #{face}, whose swept curve is not in a half-plane through the axis"),
+                "surfaces of revolution of plane profiles",
+            ));
+        }
+        let ctrl = ctrl.into_iter().map(|p| P3::new(p.x.max(0.0), 0.0, p.z)).collect();
+        Ok((iso, SplineCurve { ctrl, ..curve }))
     }
 
     /// A positive length parameter in mm.
@@ -597,6 +694,115 @@ mod tests {
         check(P3::new(50.0, 50.0, -3.0), P3::new(50.0, 50.0, 0.0), -V3::z(), "plane");
     }
 
+    fn data(name: &str) -> Model {
+        let path = format!("{}/../../data/step/{name}", env!("CARGO_MANIFEST_DIR"));
+        Model::load(&Input { name: name.into(), data: std::fs::read(path).unwrap() }).unwrap()
+    }
+
+    /// The point of the cubic Bézier profile of revolve.step at t, in (r, z): written out here,
+    /// apart from the reader's spline code.
+    fn knob_profile(t: f64) -> [f64; 2] {
+        let (r, z) = ([30.0, 33.0, 22.0, 25.0], [0.0, 5.0, 10.0, 15.0]);
+        let b = [(1.0 - t).powi(3), 3.0 * t * (1.0 - t).powi(2), 3.0 * t * t * (1.0 - t), t.powi(3)];
+        [(0..4).map(|i| b[i] * r[i]).sum(), (0..4).map(|i| b[i] * z[i]).sum()]
+    }
+
+    /// The knob of revolve.step: its two SURFACE_OF_REVOLUTION faces against the torus's closed
+    /// form (the swept exact quarter circle) and a dense search of the cubic profile, within
+    /// 0.1 µm, with the outward normal along q − foot.
+    #[test]
+    fn surfaces_of_revolution_against_closed_forms() {
+        let m = data("revolve.step");
+        let kinds: Vec<&str> = m.surfaces.iter().map(|s| s.name.split('#').next().unwrap()).collect();
+        assert_eq!(kinds.iter().filter(|k| **k == "revolution").count(), 2, "{kinds:?}");
+        assert_eq!(kinds.iter().filter(|k| **k == "plane").count(), 2, "{kinds:?}");
+        for (x, y, z) in [(24.0, 3.0, 18.0), (-15.0, 18.0, 21.0), (0.5, -27.0, 16.0), (19.0, -12.0, 19.5)] {
+            let q = P3::new(x, y, z);
+            let n = m.nearest(&q);
+            let rho: f64 = x.hypot(y);
+            let want = ((rho - 20.0).hypot(z - 15.0) - 5.0).abs();
+            assert!(m.surfaces[n.surface].name.starts_with("revolution"), "{q}: {}", m.surfaces[n.surface].name);
+            assert!((n.distance - want).abs() < 1e-7, "{q}: {} vs {want}", n.distance);
+            assert!((n.normal - n.direction(&q)).norm() < 1e-7, "{q}: normal {}", n.normal);
+        }
+        for (x, y, z) in [(33.0, 4.0, 5.0), (-20.0, -15.0, 8.0), (0.0, 28.0, 12.0), (24.0, 24.0, 2.0)] {
+            let q = P3::new(x, y, z);
+            let n = m.nearest(&q);
+            let rho: f64 = x.hypot(y);
+            let d = |t: f64| {
+                let [r, h] = knob_profile(t);
+                (r - rho).hypot(h - z)
+            };
+            // The densest sample, then golden sections on its neighbourhood.
+            let k: usize = 100_000;
+            let i = (0..=k).min_by(|a, b| d(*a as f64 / k as f64).total_cmp(&d(*b as f64 / k as f64))).unwrap();
+            let (mut a, mut b) = (i.saturating_sub(1) as f64 / k as f64, ((i + 1).min(k)) as f64 / k as f64);
+            for _ in 0..100 {
+                let (c, e) = (b - (b - a) * 0.618, a + (b - a) * 0.618);
+                if d(c) < d(e) { b = e } else { a = c }
+            }
+            let want = d(0.5 * (a + b));
+            assert!(m.surfaces[n.surface].name.starts_with("revolution"), "{q}: {}", m.surfaces[n.surface].name);
+            assert!((n.distance - want).abs() < 1e-7, "{q}: {} vs {want}", n.distance);
+            // Outward: along q − foot outside the knob, against it inside.
+            assert!(n.normal.cross(&n.direction(&q)).norm() < 1e-6, "{q}: normal {}", n.normal);
+            assert!(n.normal.z.abs() < 1.0 && n.normal.xy().dot(&q.coords.xy()) > 0.0, "{q}: normal {}", n.normal);
+        }
+        // Over the top disc.
+        let n = m.nearest(&P3::new(5.0, -6.0, 23.0));
+        assert!((n.point - P3::new(5.0, -6.0, 20.0)).norm() < 1e-12 && n.normal == V3::z(), "{}", n.point);
+    }
+
+    /// The closed periodic B-spline tube of tube.step is the cone r = 10 + z/6 (0 ≤ z ≤ 30): nearest
+    /// points on both sides of its seam (u = 0 on +x) and inside it against that closed form.
+    #[test]
+    fn closed_bspline_tube_against_its_cone() {
+        let m = data("tube.step");
+        assert_eq!(m.surfaces.len(), 1);
+        // Distance from (r, z) to the cone's generating segment (10, 0)–(15, 30).
+        let cone = |q: &P3| {
+            let (p, a, b) = ([q.x.hypot(q.y), q.z], [10.0, 0.0], [15.0, 30.0]);
+            let d = [b[0] - a[0], b[1] - a[1]];
+            let t = (((p[0] - a[0]) * d[0] + (p[1] - a[1]) * d[1]) / (d[0] * d[0] + d[1] * d[1])).clamp(0.0, 1.0);
+            (p[0] - a[0] - t * d[0]).hypot(p[1] - a[1] - t * d[1])
+        };
+        for (x, y, z) in [
+            (14.0, 0.01, 12.0),
+            (14.0, -0.01, 12.0),
+            (8.0, -1e-7, 20.0),
+            (9.0, 1e-7, 3.0),
+            (-3.0, 11.0, 25.0),
+            (0.0, -16.0, 4.0),
+            (2.0, 2.0, 15.0),
+            (13.0, 0.0, 33.0),
+        ] {
+            let q = P3::new(x, y, z);
+            let n = m.nearest(&q);
+            assert!((n.distance - cone(&q)).abs() < 1e-7, "{q}: {} vs {}", n.distance, cone(&q));
+            assert!(n.converged);
+        }
+    }
+
+    /// The void of void.step (an ORIENTED_CLOSED_SHELL .F. round a sphere face): its normal
+    /// points into the void, out of the material; the block's outside faces point out.
+    #[test]
+    fn a_reversed_shell_turns_its_faces_over() {
+        let m = data("void.step");
+        let centre = P3::new(30.0, 30.0, 20.0);
+        for q in [P3::new(30.0, 30.0, 22.0), P3::new(25.0, 33.0, 18.0), P3::new(30.0, 30.0, 28.0)] {
+            let n = m.nearest(&q);
+            let u = (q - centre).normalize();
+            assert!(m.surfaces[n.surface].name.starts_with("sphere"), "{}", m.surfaces[n.surface].name);
+            assert!((n.point - (centre + u * 10.0)).norm() < 1e-12, "{q}: {}", n.point);
+            assert!((n.normal + u).norm() < 1e-12, "{q}: normal {} should point into the void", n.normal);
+        }
+        let n = m.nearest(&P3::new(30.0, 30.0, 45.0));
+        assert!((n.point - P3::new(30.0, 30.0, 40.0)).norm() < 1e-12 && n.normal == V3::z());
+        // The sphere face, bounded by a vertex loop alone, is the whole sphere.
+        let n = m.nearest(&P3::new(30.0, 30.0, 15.0));
+        assert!((n.point - P3::new(30.0, 30.0, 10.0)).norm() < 1e-12, "{}", n.point);
+    }
+
     fn step(body: &str) -> String {
         format!("ISO-10303-21;\nHEADER;\nENDSEC;\nDATA;\n{body}ENDSEC;\nEND-ISO-10303-21;\n")
     }
@@ -657,9 +863,9 @@ mod tests {
         let e = load(&step(&square("SI_UNIT(.MILLI.,.METRE.)", revolved)), false).unwrap_err();
         assert_eq!(e.exit_status(), 2);
         assert!(
-            e.to_string()
-                .starts_with("t.stp:35: unsupported entity SURFACE_OF_REVOLUTION #80 (the surface of face #82)")
-                && e.to_string().ends_with("--skip-unsupported leaves such faces out"),
+            e.to_string().starts_with(
+                "t.stp:20: unsupported entity LINE #50 (the swept curve of SURFACE_OF_REVOLUTION #80 of face #82)"
+            ) && e.to_string().ends_with("--skip-unsupported leaves such faces out"),
             "{e}"
         );
         let m = load(&step(&square("SI_UNIT(.MILLI.,.METRE.)", revolved)), true).unwrap();
