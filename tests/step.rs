@@ -411,7 +411,8 @@ fn fixed_axis_cutters_on_surfaces_of_revolution() {
         profile.extend([[20.0 + 5.0 * a.cos(), 15.0 + 5.0 * a.sin()], [20.0 * t, 20.0], [30.0 * t, 0.0]]);
     }
     let (radius, corner, half) = (3.0f64, 1.0f64, 40f64.to_radians());
-    let tools: [(&str, &str, Box<dyn Fn(f64) -> f64>); 4] = [
+    type Profile = Box<dyn Fn(f64) -> f64>;
+    let tools: [(&str, &str, Profile); 4] = [
         ("flat", r#"{"kind": "flat", "radius": 3}"#, Box::new(|_| 0.0)),
         ("ball", r#"{"kind": "ball", "radius": 3}"#, Box::new(move |d: f64| radius - (radius * radius - d * d).sqrt())),
         (
