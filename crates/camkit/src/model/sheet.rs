@@ -421,24 +421,7 @@ fn golden_arg(f: impl Fn(f64) -> f64, a: f64, b: f64) -> f64 {
 
 /// The largest of a concave `f` on [a, b] (golden section, the ends included).
 fn golden_max(f: impl Fn(f64) -> f64, a: f64, b: f64) -> f64 {
-    const R: f64 = 0.618_033_988_749_894_9;
-    let (mut lo, mut hi) = (a, b);
-    let (mut x1, mut x2) = (hi - R * (hi - lo), lo + R * (hi - lo));
-    let (mut f1, mut f2) = (f(x1), f(x2));
-    for _ in 0..GOLDEN {
-        if f1 < f2 {
-            lo = x1;
-            (x1, f1) = (x2, f2);
-            x2 = lo + R * (hi - lo);
-            f2 = f(x2);
-        } else {
-            hi = x2;
-            (x2, f2) = (x1, f1);
-            x1 = hi - R * (hi - lo);
-            f1 = f(x1);
-        }
-    }
-    f1.max(f2).max(f(a)).max(f(b))
+    f(golden_arg(&f, a, b)).max(f(a)).max(f(b))
 }
 
 /// The largest tip over points below the plane (through `a`, unit normal `n`, n.z > 0) whose
