@@ -12,7 +12,9 @@ SHELL := bash
 MAKEFLAGS += --no-builtin-rules --warn-undefined-variables
 
 CARGO ?= cargo
-RELEASE := target/release
+# Where cargo puts release binaries: its default, or the user's CARGO_TARGET_DIR.
+CARGO_TARGET_DIR ?= target
+RELEASE := $(CARGO_TARGET_DIR)/release
 OUT := out
 
 # Each demo part's pipeline is a fragment mk/<part>.mk that adds itself to DEMOS and the filters
