@@ -214,18 +214,7 @@ fn tool_attitude_gouge_checks_against_step_faces() {
     let rows = table(&cl);
     let k = rows.len() / 2;
     let nz = num(&rows[k], "nz");
-    let mut lines: Vec<String> = cl.lines().map(str::to_string).collect();
-    let header: Vec<&str> = lines[0].split(',').collect();
-    let (iz, ipz) = (header.iter().position(|h| *h == "z").unwrap(), header.iter().position(|h| *h == "pz").unwrap());
-    let mut f: Vec<String> = lines[k + 1].split(',').map(str::to_string).collect();
-    for i in [iz, ipz] {
-        f[i] = (f[i].parse::<f64>().unwrap() - 0.1).to_string();
-    }
-    lines[k + 1] = f.join(",");
-    w.write("low.csv", lines.join("\n") + "\n");
-    let o = w.run("tool-attitude", &args("low.csv"), b"");
-    o.fails(1, &format!("low.csv:{}: 1 row(s) gouge the model by more than 0.001 mm", k + 2));
-    let deepest: f64 = o.stderr.split("deepest ").nth(1).unwrap().trim_end().trim_end_matches(" mm)").parse().unwrap();
+    let deepest = lowered_gouge(&w, &cl, k, &args("low.csv"));
     assert!((deepest - 0.1 * nz).abs() <= chord + 1e-6, "deepest {deepest} vs {}", 0.1 * nz);
 }
 
@@ -373,18 +362,7 @@ fn tool_attitude_gouge_checks_surfaces_of_revolution() {
     // A row on the cubic face, 0.1 mm lower.
     let k = rows.iter().position(|r| text(r, "surface").starts_with("revolution") && num(r, "pz") < 14.0).unwrap();
     let nz = num(&rows[k], "nz");
-    let mut lines: Vec<String> = cl.lines().map(str::to_string).collect();
-    let header: Vec<&str> = lines[0].split(',').collect();
-    let (iz, ipz) = (header.iter().position(|h| *h == "z").unwrap(), header.iter().position(|h| *h == "pz").unwrap());
-    let mut f: Vec<String> = lines[k + 1].split(',').map(str::to_string).collect();
-    for i in [iz, ipz] {
-        f[i] = (f[i].parse::<f64>().unwrap() - 0.1).to_string();
-    }
-    lines[k + 1] = f.join(",");
-    w.write("low.csv", lines.join("\n") + "\n");
-    let o = w.run("tool-attitude", &args("low.csv"), b"");
-    o.fails(1, &format!("low.csv:{}: 1 row(s) gouge the model by more than 0.001 mm", k + 2));
-    let deepest: f64 = o.stderr.split("deepest ").nth(1).unwrap().trim_end().trim_end_matches(" mm)").parse().unwrap();
+    let deepest = lowered_gouge(&w, &cl, k, &args("low.csv"));
     // The ball's depth in the curved face: its radius less the lowered centre's distance from
     // the swept cubic (the profile written out here); about 0.1 n_z.
     let c = p3(&rows[k], "x", "y", "z") - V3::z() * 0.1;
@@ -444,4 +422,21 @@ fn fixed_axis_cutters_on_surfaces_of_revolution() {
             assert!(tip.z - brute <= 2e-3, "{name}: tip {tip} {} above every sample", tip.z - brute);
         }
     }
+}
+
+/// tool-attitude run with `args` (its input low.csv) on the table `cl` with row `k`'s tip and
+/// contact moved 0.1 mm down: it fails naming that one row, and the depth it reports.
+fn lowered_gouge(w: &Work, cl: &str, k: usize, args: &[&str]) -> f64 {
+    let mut lines: Vec<String> = cl.lines().map(str::to_string).collect();
+    let header: Vec<&str> = lines[0].split(',').collect();
+    let (iz, ipz) = (header.iter().position(|h| *h == "z").unwrap(), header.iter().position(|h| *h == "pz").unwrap());
+    let mut f: Vec<String> = lines[k + 1].split(',').map(str::to_string).collect();
+    for i in [iz, ipz] {
+        f[i] = (f[i].parse::<f64>().unwrap() - 0.1).to_string();
+    }
+    lines[k + 1] = f.join(",");
+    w.write("low.csv", lines.join("\n") + "\n");
+    let o = w.run("tool-attitude", args, b"");
+    o.fails(1, &format!("low.csv:{}: 1 row(s) gouge the model by more than 0.001 mm", k + 2));
+    o.stderr.split("deepest ").nth(1).unwrap().trim_end().trim_end_matches(" mm)").parse().unwrap()
 }

@@ -45,6 +45,29 @@ fn round_half_away(x: f64) -> f64 {
     if x >= 0.0 { (x + 0.5) as i64 as f64 } else { (x - 0.5) as i64 as f64 }
 }
 
+/// Where a unimodal `f` is largest on [a, b]: `iterations` golden sections (ties keep the lower
+/// part), then the better of the last two points.
+pub fn golden_arg(f: impl Fn(f64) -> f64, a: f64, b: f64, iterations: usize) -> f64 {
+    let r = 0.5 * (5f64.sqrt() - 1.0);
+    let (mut lo, mut hi) = (a, b);
+    let (mut x1, mut x2) = (hi - r * (hi - lo), lo + r * (hi - lo));
+    let (mut f1, mut f2) = (f(x1), f(x2));
+    for _ in 0..iterations {
+        if f1 < f2 {
+            lo = x1;
+            (x1, f1) = (x2, f2);
+            x2 = lo + r * (hi - lo);
+            f2 = f(x2);
+        } else {
+            hi = x2;
+            (x2, f2) = (x1, f1);
+            x1 = hi - r * (hi - lo);
+            f1 = f(x1);
+        }
+    }
+    if f1 >= f2 { x1 } else { x2 }
+}
+
 /// `v` rounded to `decimals` places: exactly the value a reader parses back from
 /// [`push_fixed`]'s text (integer / 10^d is correctly rounded, as parsing is).
 pub fn round_to(v: f64, decimals: u32) -> f64 {

@@ -122,24 +122,8 @@ fn farthest_from_line(x: &Extreme, p: &P3, e: &V3) -> f64 {
 
 /// The largest value of `g` on `[a, b]`, where it rises to one maximum and falls (golden
 /// section to the interval's round-off).
-fn golden_max(g: &dyn Fn(f64) -> f64, mut a: f64, mut b: f64) -> f64 {
-    let r = 0.5 * (5f64.sqrt() - 1.0);
-    let (mut c, mut d) = (b - r * (b - a), a + r * (b - a));
-    let (mut gc, mut gd) = (g(c), g(d));
-    for _ in 0..80 {
-        if gc >= gd {
-            b = d;
-            (d, gd) = (c, gc);
-            c = b - r * (b - a);
-            gc = g(c);
-        } else {
-            a = c;
-            (c, gc) = (d, gd);
-            d = a + r * (b - a);
-            gd = g(d);
-        }
-    }
-    gc.max(gd)
+fn golden_max(g: &dyn Fn(f64) -> f64, a: f64, b: f64) -> f64 {
+    g(crate::num::golden_arg(g, a, b, 80))
 }
 
 #[cfg(test)]

@@ -23,6 +23,7 @@ use super::cutter::{Cutter, Plane, Touch};
 use super::face::{Carrier, Curve, Face, SplineCurve};
 use super::patch::{bezier_knots, bezier_spans};
 use crate::geom::{P3, V3};
+use crate::num::golden_arg;
 use nalgebra::Isometry3;
 use std::cmp::Ordering;
 use std::collections::BinaryHeap;
@@ -354,7 +355,7 @@ fn drop_curve(c: &Cutter, q: [f64; 2], at: impl Fn(f64) -> P3, lo: f64, hi: f64)
         let a = if k > 0 { if gs[k - 1].is_some() { ss[k - 1] } else { ends[k - 1] } } else { ss[k] };
         let b = if k < n { if gs[k + 1].is_some() { ss[k + 1] } else { ends[k + 1] } } else { ss[k] };
         let f = |s: f64| g(s).map_or(f64::NEG_INFINITY, |x| x.0);
-        let s = golden_arg(f, a, b);
+        let s = golden_arg(f, a, b, GOLDEN);
         take(g(s));
     }
     best
@@ -397,31 +398,9 @@ impl Ord for Node {
     }
 }
 
-/// Where a unimodal `f` is largest on [a, b] (golden section).
-fn golden_arg(f: impl Fn(f64) -> f64, a: f64, b: f64) -> f64 {
-    const R: f64 = 0.618_033_988_749_894_9;
-    let (mut lo, mut hi) = (a, b);
-    let (mut x1, mut x2) = (hi - R * (hi - lo), lo + R * (hi - lo));
-    let (mut f1, mut f2) = (f(x1), f(x2));
-    for _ in 0..GOLDEN {
-        if f1 < f2 {
-            lo = x1;
-            (x1, f1) = (x2, f2);
-            x2 = lo + R * (hi - lo);
-            f2 = f(x2);
-        } else {
-            hi = x2;
-            (x2, f2) = (x1, f1);
-            x1 = hi - R * (hi - lo);
-            f1 = f(x1);
-        }
-    }
-    if f1 >= f2 { x1 } else { x2 }
-}
-
 /// The largest of a concave `f` on [a, b] (golden section, the ends included).
 fn golden_max(f: impl Fn(f64) -> f64, a: f64, b: f64) -> f64 {
-    f(golden_arg(&f, a, b)).max(f(a)).max(f(b))
+    f(golden_arg(&f, a, b, GOLDEN)).max(f(a)).max(f(b))
 }
 
 /// The largest tip over points below the plane (through `a`, unit normal `n`, n.z > 0) whose
