@@ -52,12 +52,12 @@ for spec in "box-die 0 0 100 100 60" "islands2 0 0 100 60 10" "dumbbell 0 0 94 4
   SRCP=data/medial-trochoid/$P.csv
   fcout=$(python3 scripts/freecad-adaptive.py "$SRCP" "$tmp/fc-$P.csv" --diameter 10 --stepover 11.82 --stock "$2" "$3" "$4" "$5" --top "$6")
   fcsec=$(echo "$fcout" | sed -n 's/.*seconds \([0-9.]*\).*/\1/p')
-  "$B" "$SRCP" "${COMMON[@]}" --threshold 40 --force-at 40 --analyse "$tmp/fc-$P.csv" --report "$tmp/fc-$P.json" -o /dev/null
+  "$B" "$SRCP" "${COMMON[@]}" --threshold 40 --force-at 40 --analyse "$tmp/fc-$P.csv" --report "$tmp/fc-$P.json" -o "$tmp/fca-$P.csv"
   for TARGET_DEG in $TARGETS; do
   # "freecad": FreeCAD's measured largest engagement rounded down to the degree (the issue's bound).
   [ "$TARGET_DEG" = freecad ] && TARGET_DEG=$(python3 -c "import json,sys,math; print(math.floor(json.load(open(sys.argv[1]))['largest_engagement_deg']))" "$tmp/fc-$P.json")
   RAYON_NUM_THREADS=1 "$B" "$SRCP" "${COMMON[@]}" --strategy adaptive --threshold "$TARGET_DEG" --force-at 40 --report "$tmp/ad-$P.json" -o "$tmp/ad-$P.csv" 2>/dev/null
-  "$B" "$SRCP" "${COMMON[@]}" --threshold "$TARGET_DEG" --force-at 40 --analyse "$tmp/ad-$P.csv" --report "$tmp/ada-$P.json" -o /dev/null
+  "$B" "$SRCP" "${COMMON[@]}" --threshold "$TARGET_DEG" --force-at 40 --analyse "$tmp/ad-$P.csv" --report "$tmp/ada-$P.json" -o "$tmp/adaa-$P.csv"
   python3 - "$P@$TARGET_DEG°" "$fcsec" "$tmp/fc-$P.json" "$tmp/ad-$P.json" "$tmp/ada-$P.json" <<'PY'
 import json, sys
 p, fcsec = sys.argv[1], float(sys.argv[2])
@@ -70,5 +70,35 @@ kinds = lambda t: ", ".join(f"{k} {v['minutes']:.2f} min / {v['mm']:.0f} mm" if 
 print(f"  FreeCAD by kind: {kinds(fc['time_by_kind'])}; chains {fc['chains']}, air above the layer {fc['air_length_mm']:.0f} mm")
 print(f"  ours by kind:    {kinds(ada['time_by_kind'])}")
 PY
+  # Passes by length (a pass: a run of cutting rows; with it the links and air rows before it),
+  # minutes as each row's length over its analysed feed: where short passes cost the time.
+  for prog in "FreeCAD:$tmp/fca-$P.csv" "ours:$tmp/adaa-$P.csv"; do
+  python3 - "${prog%%:*}" "${prog#*:}" <<'PY'
+import csv, math, sys
+rows = list(csv.DictReader(open(sys.argv[2])))
+passes, prev, link, cutting_before = [], None, [0.0, 0.0], False
+for r in rows:
+    p = (float(r["x"]), float(r["y"]))
+    d = math.dist(prev, p) if prev and r["move"] in ("line", "cw", "ccw") and r["f"] else 0.0
+    t = d / float(r["f"]) if d else 0.0
+    prev = p
+    cutting = r["tag"] in ("contour", "cutting")
+    if cutting and not cutting_before:
+        passes.append({"mm": 0.0, "min": 0.0, "link_min": link[1]})
+        link = [0.0, 0.0]
+    cutting_before = cutting
+    if cutting:
+        passes[-1]["mm"] += d
+        passes[-1]["min"] += t
+    elif r["tag"] != "entry":
+        link = [link[0] + d, link[1] + t]
+passes = [g for g in passes if g["mm"] > 0]
+out = []
+for lo, hi in ((0, 5), (5, 15), (15, 50), (50, math.inf)):
+    g = [x for x in passes if lo <= x["mm"] < hi]
+    out.append(f"{lo}-{hi} mm: {len(g)}, {sum(x['min'] for x in g):.2f} + links {sum(x['link_min'] for x in g):.2f} min")
+print(f"  {sys.argv[1]} passes ({len(passes)}) by length: " + "; ".join(out))
+PY
+  done
   done
 done

@@ -1,16 +1,21 @@
 //! Sets of angles on the tool circle as sorted, disjoint open intervals of [0, 2π): the
 //! arithmetic of the exact engagement angle.
 
+use smallvec::{SmallVec, smallvec};
 use std::f64::consts::TAU;
+
+/// Intervals of an [`AngleSet`]: up to four inline (a disk's set has at most two, a band's
+/// three), so that the millions of sets the engagement builds allocate nothing.
+pub type Intervals = SmallVec<[(f64, f64); 4]>;
 
 /// A set of angles (radians): sorted, disjoint intervals inside [0, 2π).
 #[derive(Clone, Debug, Default, PartialEq)]
-pub struct AngleSet(pub Vec<(f64, f64)>);
+pub struct AngleSet(pub Intervals);
 
 impl AngleSet {
     /// The whole circle.
     pub fn full() -> AngleSet {
-        AngleSet(vec![(0.0, TAU)])
+        AngleSet(smallvec![(0.0, TAU)])
     }
 
     /// Angles within `half` of `centre` (the whole circle when `half ≥ π`).
@@ -23,7 +28,7 @@ impl AngleSet {
         }
         let a = (centre - half).rem_euclid(TAU);
         let b = a + 2.0 * half;
-        if b <= TAU { AngleSet(vec![(a, b)]) } else { AngleSet(vec![(0.0, b - TAU), (a, TAU)]) }
+        if b <= TAU { AngleSet(smallvec![(a, b)]) } else { AngleSet(smallvec![(0.0, b - TAU), (a, TAU)]) }
     }
 
     /// Angles θ with `lo < c + r·cos(θ − phi) < hi`: the circle of radius `r` met with a band
@@ -43,7 +48,7 @@ impl AngleSet {
 
     /// Common angles of two sets.
     pub fn intersect(&self, other: &AngleSet) -> AngleSet {
-        let mut out = Vec::new();
+        let mut out = Intervals::new();
         let (mut i, mut j) = (0, 0);
         while i < self.0.len() && j < other.0.len() {
             let (a0, a1) = self.0[i];
@@ -61,7 +66,7 @@ impl AngleSet {
     pub fn union(&self, other: &AngleSet) -> AngleSet {
         let mut all: Vec<(f64, f64)> = self.0.iter().chain(&other.0).copied().collect();
         merge(&mut all);
-        AngleSet(all)
+        AngleSet(Intervals::from_vec(all))
     }
 
     /// Total measure (radians).

@@ -56,10 +56,24 @@ impl Shape {
 
 /// [`removed_by`] with the piece's [`Shape`] given.
 fn removed_shaped(p: &P2, r: f64, s: &Seg, shape: &Shape) -> AngleSet {
+    let mut out = Vec::new();
+    removed_into(p, r, s, shape, false, &mut out);
+    merge(&mut out);
+    AngleSet(crate::angles::Intervals::from_vec(out))
+}
+
+/// The intervals of [`removed_shaped`] appended to `out` unmerged (their merged union is the
+/// same set, to the bit: merging only compares and picks ends), saving a sort and two vectors
+/// per piece in [`Cut::removed`], which merges all pieces' intervals at once; `end_known`: the
+/// disk at the piece's end is already in `out` (the next piece starts there), so it is left out.
+fn removed_into(p: &P2, r: f64, s: &Seg, shape: &Shape, end_known: bool, out: &mut Vec<(f64, f64)>) {
     let (a, b) = (s.start(), s.end());
-    let mut out = disk(p, r, &a).union(&disk(p, r, &b));
+    out.extend(disk(p, r, &a).0);
+    if !end_known {
+        out.extend(disk(p, r, &b).0);
+    }
     let body = match (s, shape) {
-        (_, Shape::Point) => return out,
+        (_, Shape::Point) => return,
         (Seg::Line(..), &Shape::Line { len, t, n, at, an }) => {
             let along = AngleSet::band((p - a).dot(&t), r, at, 0.0, len);
             along.intersect(&AngleSet::band((p - a).dot(&n), r, an, -r, r))
@@ -78,8 +92,7 @@ fn removed_shaped(p: &P2, r: f64, s: &Seg, shape: &Shape) -> AngleSet {
         }
         _ => unreachable!("a shape is made from its own piece"),
     };
-    out = out.union(&body);
-    out
+    out.extend(body.0);
 }
 
 /// Angles whose circle point is closer than `r` to `c` (open disk of radius `r`).
@@ -200,7 +213,7 @@ impl Cut {
         let r = self.radius;
         let touches = |b: &(P2, P2)| boxes_within(b, &(*p, *p), 2.0 * r);
         let reach = r + SCREEN_MARGIN;
-        let mut all: Vec<(f64, f64)> = Vec::new();
+        let mut all: Vec<(f64, f64)> = Vec::with_capacity(32);
         let mut screen: Option<Vec<(P2, P2)>> = None;
         let mut taken = 0;
         let old = before.saturating_sub(RECENT);
@@ -209,11 +222,19 @@ impl Cut {
             .rev()
             .map(|s| (s, s.bounds(), None))
             .chain((old..before).rev().map(|j| (&self.pieces[j], self.boxes[j], Some(&self.shapes[j]))));
+        // Start of the piece taken last (the next in cutting order): the disk there is taken.
+        let mut next_start: Option<P2> = None;
         for (s, b, shape) in latest {
             if !touches(&b) || screen.as_ref().is_some_and(|q| !q.iter().any(|q| boxes_within(&b, q, reach))) {
+                next_start = None;
                 continue;
             }
-            all.extend(shape.map_or_else(|| removed_by(p, r, s), |k| removed_shaped(p, r, s, k)).0);
+            let end_known = next_start == Some(s.end());
+            match shape {
+                Some(k) => removed_into(p, r, s, k, end_known, &mut all),
+                None => removed_into(p, r, s, &Shape::of(s), end_known, &mut all),
+            }
+            next_start = Some(s.start());
             taken += 1;
             if taken % SCREEN_EVERY == 0 {
                 merge(&mut all);
@@ -238,7 +259,7 @@ impl Cut {
                         {
                             continue;
                         }
-                        all.extend(removed_shaped(p, r, &self.pieces[j], &self.shapes[j]).0);
+                        removed_into(p, r, &self.pieces[j], &self.shapes[j], false, &mut all);
                         taken += 1;
                         if taken % SCREEN_EVERY == 0 {
                             merge(&mut all);

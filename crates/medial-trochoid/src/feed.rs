@@ -30,7 +30,7 @@ impl Load {
     /// The load of material on the arcs `arcs` (radians, sorted and disjoint within [0, 2π))
     /// of the tool circle for travel at angle `gamma`; arcs behind the tool carry none.
     pub fn of_arcs(arcs: &[(f64, f64)], gamma: f64) -> Load {
-        let ahead = AngleSet(arcs.to_vec()).intersect(&AngleSet::around(gamma, FRAC_PI_2));
+        let ahead = AngleSet(arcs.iter().copied().collect()).intersect(&AngleSet::around(gamma, FRAC_PI_2));
         let (mut x, mut y, mut chip) = (0.0, 0.0, 0.0f64);
         for &(a, b) in &ahead.0 {
             // ∫ cos(β − γ)(cos β, sin β) dβ = ½ ∫ (cos(2β − γ) + cos γ, sin(2β − γ) + sin γ) dβ.
