@@ -650,3 +650,61 @@ fn fixed_axis_streams_across_chunks() {
     w.run(BIN, &[&args[..7], &["-o", "t.csv"]].concat(), b"").fails(1, "cl.csv:35002: 5000 row(s) gouge");
     assert!(!w.exists("t.csv"));
 }
+
+/// The tilt modes stream pass by pass (a row's feed direction needs its neighbours): whole passes
+/// are solved in parallel once a chunk's worth of rows waits. Thirty passes across a concave
+/// cylinder, solved as one chunk (the default holds them all: the whole-program answer), one pass
+/// at a time and seven rows at a time, on one thread and on three, give the same table and
+/// figures; a bad row in the last pass is still refused with its line, and nothing is written.
+#[test]
+fn tilt_modes_stream_pass_by_pass() {
+    let w = Work::new();
+    w.write(
+        "m.json",
+        r#"{"surfaces": [{"type": "cylinder", "point": [0, 0, 100], "axis": [0, 1, 0], "radius": 100, "flip": true}]}"#,
+    );
+    w.write("tool.json", CYL);
+    let mut cl = String::from("path,x,y,z,px,py,pz,nx,ny,nz\n");
+    for pass in 0..30 {
+        let contacts = circle(P3::new(0.0, pass as f64, 100.0), (V3::x(), V3::z()), 100.0, (-1.7, 0.01, 40), true);
+        for (p, n) in &contacts {
+            let c = p + n * 12.5;
+            cl += &format!("{pass},{},{},{},{},{},{},{},{},{}\n", c.x, c.y, c.z, p.x, p.y, p.z, n.x, n.y, n.z);
+        }
+    }
+    w.write("cl.csv", &cl);
+    let run = |threads: &str, chunk: Option<&str>| {
+        let mut c = std::process::Command::new(e2e::bin(BIN));
+        c.args(["cl.csv", "--tool", "tool.json", "--model", "m.json", "--report", "r.json"]);
+        if let Some(n) = chunk {
+            c.args(["--chunk-rows", n]);
+        }
+        let out = c.current_dir(w.path("")).env("RAYON_NUM_THREADS", threads).output().expect("run");
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        let mut r: serde_json::Value = serde_json::from_str(&w.read("r.json")).unwrap();
+        for k in ["seconds", "solve_seconds", "rows_per_second", "threads"] {
+            r.as_object_mut().unwrap().remove(k);
+        }
+        (out.stdout, r)
+    };
+    let whole = run("3", None);
+    assert_eq!(whole.1["rows"].as_u64(), Some(1200));
+    assert_eq!(whole.1["paths"].as_u64(), Some(30));
+    assert_eq!(String::from_utf8_lossy(&whole.0).lines().count(), 1201);
+    for (threads, chunk) in [("1", None), ("1", Some("1")), ("3", Some("1")), ("3", Some("7")), ("1", Some("40"))] {
+        let got = run(threads, chunk);
+        assert!(got.0 == whole.0, "table differs on {threads} threads, chunks of {chunk:?} rows");
+        assert_eq!(got.1, whole.1, "report on {threads} threads, chunks of {chunk:?} rows");
+    }
+    // The last pass's 20th row without its normal: refused by line, in any chunking.
+    let mut bad: Vec<String> = cl.lines().map(str::to_string).collect();
+    let line = 1 + 29 * 40 + 20;
+    let f: Vec<&str> = bad[line - 1].split(',').collect();
+    bad[line - 1] = format!("{},,,", f[..7].join(","));
+    w.write("bad.csv", bad.join("\n") + "\n");
+    for chunk in ["1", "16384"] {
+        w.run(BIN, &["bad.csv", "--tool", "tool.json", "--chunk-rows", chunk, "-o", "out.csv"], b"")
+            .fails(2, &format!("bad.csv:{line}:8 (nx): empty contact point or normal"));
+        assert!(!w.exists("out.csv"));
+    }
+}

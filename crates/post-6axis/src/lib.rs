@@ -19,7 +19,7 @@ use camkit::doc::machine::Machine;
 use camkit::error::{Error, Location, Result};
 use camkit::gcode::read_axes;
 use camkit::kinematics::{Chain, Solver};
-use camkit::table::{Col, Move, Table};
+use camkit::table::{Col, Move, Row, Schema};
 use plan::{Cl, ClArc, SpindleSetup};
 
 /// What the user asks of one run.
@@ -59,42 +59,61 @@ pub fn feed_range(machine: &Machine) -> (f64, f64) {
     ((unit * 10f64.powi(-(machine.program.decimals.feed as i32))).max(1e-3), MAX_FEED)
 }
 
-/// CL rows from a toolpath table, checked: a tool axis on multi-axis machines, unit axes
-/// (normalised when within 1e-3 of unit, counted in the second value), a feed within
-/// [`feed_range`] for every cutting row (`feed`, the default, is the caller's to check), spindle orientations only for a machine that can command them, arcs with a start (not the
-/// first row of a pass) and radii at both ends within `arc_tol` (mm) of each other.
-pub fn cl_rows(
-    table: &Table,
-    file: &str,
-    chain: &Chain,
-    machine: &Machine,
+/// CL rows read one at a time from rows of one schema, checked: a tool axis on multi-axis
+/// machines, unit axes (normalised when within 1e-3 of unit, counted in
+/// [`ClReader::normalised`]), a feed within [`feed_range`] for every cutting row (`feed`, the
+/// default, is the caller's to check), spindle orientations only for a machine that can command
+/// them, arcs with a start (not the first row of a pass) and radii at both ends within `arc_tol`
+/// (mm) of each other.
+pub struct ClReader<'a> {
+    file: &'a str,
+    machine: &'a Machine,
     feed: Option<f64>,
     arc_tol: f64,
-) -> Result<(Vec<Cl>, usize)> {
-    let at = |line: u64, field: &str| Location::file(file).line(line).field(field);
-    if !chain.rotaries().is_empty() && !table.schema.has(Col::I) {
-        return Err(Error::input("missing columns i, j, k: a multi-axis machine needs the tool axis of every row")
-            .at(Location::file(file).line(1)));
+    prev_path: Option<i64>,
+    last: Option<Cl>,
+    /// Rows read.
+    pub rows: usize,
+    /// Tool axes normalised.
+    pub normalised: usize,
+}
+
+impl<'a> ClReader<'a> {
+    /// A reader of rows of `schema` (read from `file`) for `machine`; refuses a schema that
+    /// lacks what the machine needs.
+    pub fn new(
+        schema: &Schema,
+        file: &'a str,
+        chain: &Chain,
+        machine: &'a Machine,
+        feed: Option<f64>,
+        arc_tol: f64,
+    ) -> Result<ClReader<'a>> {
+        if !chain.rotaries().is_empty() && !schema.has(Col::I) {
+            return Err(Error::input("missing columns i, j, k: a multi-axis machine needs the tool axis of every row")
+                .at(Location::file(file).line(1)));
+        }
+        if schema.has(Col::S) && machine.spindle.is_none() {
+            return Err(Error::input(
+                "the rows carry spindle orientations (column s) but the machine document has no `spindle` to command them",
+            )
+            .at(Location::file(file).line(1).field("s")));
+        }
+        Ok(ClReader { file, machine, feed, arc_tol, prev_path: None, last: None, rows: 0, normalised: 0 })
     }
-    if table.schema.has(Col::S) && machine.spindle.is_none() {
-        return Err(Error::input(
-            "the rows carry spindle orientations (column s) but the machine document has no `spindle` to command them",
-        )
-        .at(Location::file(file).line(1).field("s")));
-    }
-    let mut out = Vec::with_capacity(table.rows.len());
-    let mut normalised = 0;
-    let mut prev_path = None;
-    for row in &table.rows {
+
+    /// The CL row of one table row.
+    pub fn row(&mut self, row: &Row) -> Result<Cl> {
+        let at = |line: u64, field: &str| Location::file(self.file).line(line).field(field);
         let n = row.axis.norm();
         if !n.is_finite() || (n - 1.0).abs() > camkit::tol::UNIT_VECTOR_SLACK {
             return Err(Error::input(format!("the tool axis has length {n}, not 1")).at(at(row.line, "i,j,k")));
         }
         if (n - 1.0).abs() > UNIT_EXACT {
-            normalised += 1;
+            self.normalised += 1;
         }
-        let rapid = row.mv == Move::Rapid || prev_path != Some(row.path);
-        prev_path = Some(row.path);
+        let rapid = row.mv == Move::Rapid || self.prev_path != Some(row.path);
+        self.prev_path = Some(row.path);
         let arc = match (row.mv, row.centre) {
             (Move::Cw | Move::Ccw, _) if rapid => {
                 return Err(Error::input("an arc needs a start: the first row of a pass cannot be cw or ccw")
@@ -102,11 +121,12 @@ pub fn cl_rows(
             }
             (Move::Cw | Move::Ccw, Some(centre)) => {
                 let arc = ClArc { plane: row.plane, centre, ccw: row.mv == Move::Ccw };
-                let start: &Cl = out.last().expect("an arc follows a row of its pass");
+                let start = self.last.as_ref().expect("an arc follows a row of its pass");
                 let (r0, r1) = arc.radii(&start.tip, &row.pos);
-                if (r0 - r1).abs() > arc_tol || r0.is_nan() || r0 <= 0.0 {
+                if (r0 - r1).abs() > self.arc_tol || r0.is_nan() || r0 <= 0.0 {
                     return Err(Error::input(format!(
-                        "the arc's ends are {r0:.6} and {r1:.6} mm from its centre: more than {arc_tol} mm apart, not one circle"
+                        "the arc's ends are {r0:.6} and {r1:.6} mm from its centre: more than {} mm apart, not one circle",
+                        self.arc_tol
                     ))
                     .at(at(row.line, "xc,yc")));
                 }
@@ -117,32 +137,23 @@ pub fn cl_rows(
             }
             _ => None,
         };
-        let (lo, hi) = feed_range(machine);
+        let (lo, hi) = feed_range(self.machine);
         if let Some(v) = row.f
             && !(lo..=hi).contains(&v)
         {
             let v = if (1e-6..1e9).contains(&v.abs()) { v.to_string() } else { format!("{v:e}") };
             return Err(Error::input(format!("feed must be from {lo} to {hi} mm/min, got {v}")).at(at(row.line, "f")));
         }
-        let f = row.f.or(feed);
+        let f = row.f.or(self.feed);
         if f.is_none() && !rapid {
             return Err(Error::input("no feed for this move: give the f column or --feed").at(at(row.line, "f")));
         }
-        out.push(Cl {
-            tip: row.pos,
-            axis: row.axis / n,
-            s: row.s,
-            feed: f,
-            rapid,
-            reorient: rapid,
-            line: row.line,
-            arc,
-        });
+        let cl =
+            Cl { tip: row.pos, axis: row.axis / n, s: row.s, feed: f, rapid, reorient: rapid, line: row.line, arc };
+        self.last = Some(cl);
+        self.rows += 1;
+        Ok(cl)
     }
-    if out.is_empty() {
-        return Err(Error::input("no rows: nothing to post").at(Location::file(file)));
-    }
-    Ok((out, normalised))
 }
 
 /// The planning view of a machine.
@@ -252,15 +263,25 @@ pub fn post(
         interpolate_singular: machine.singular == camkit::doc::machine::SingularRule::Interpolate,
     };
     let m = planning(machine, chain);
-    let (steps, stats) = plan::plan(rows, &m, &opts).map_err(|e| {
+    // Blocks are written as they are planned; a move without a feed is refused once planning
+    // has found nothing worse (as when the whole plan came first).
+    let wopts = nc::WriteOptions { rotary_radius: s.rotary_radius, comments };
+    let mut writer = nc::Writer::new(machine, chain, &wopts);
+    let mut no_feed = None;
+    let stats = plan::plan_each(rows, &m, &opts, &mut |step| {
+        if no_feed.is_none() {
+            no_feed = writer.push(step).err();
+        }
+    })
+    .map_err(|e| {
         let loc = Location::file(file).line(rows[e.row].line).field("i,j,k");
         if e.unreachable { Error::input(e.message).at(loc) } else { Error::check(e.message).at(loc) }
     })?;
-    let wopts = nc::WriteOptions { rotary_radius: s.rotary_radius, comments };
-    let (text, written) = nc::write(&steps, machine, chain, &wopts).map_err(|nc::NoFeed(row)| {
-        Error::input("no feed for this move: give the f column or --feed")
-            .at(Location::file(file).line(rows[row].line).field("f"))
-    })?;
+    if let Some(nc::NoFeed(row)) = no_feed {
+        return Err(Error::input("no feed for this move: give the f column or --feed")
+            .at(Location::file(file).line(rows[row].line).field("f")));
+    }
+    let (text, written) = writer.finish();
     let check = check_text(&text, rows, machine, chain, s.tol)?;
     judge(&check, rows, machine, s)?;
     Ok(Posted { text, plan: stats, written, check, tol_used })
@@ -313,6 +334,7 @@ pub fn check_text(text: &[u8], rows: &[Cl], machine: &Machine, chain: &Chain, to
         .map_err(|e| Error::runtime(format!("the written program does not read back: {e}")))?;
     let reading = readback::Reading::new(machine, chain);
     let poses = readback::poses(&program, &reading);
+    drop(program);
     Ok(readback::verify(rows, &poses, &reading, CHECK_SAMPLES, tol))
 }
 
@@ -440,6 +462,38 @@ mod tests {
         let e = judge(&off, &rows, &m, &s).unwrap_err();
         assert_eq!(e.kind, camkit::error::ErrorKind::Check, "{e}");
         assert!(e.to_string().contains("NC line 42, rows at input lines 5, 6, 11"), "{e}");
+    }
+
+    /// The post writes each block as planning hands it over (never the whole plan held): the text
+    /// is byte for byte that of the whole plan written at once, on passes that insert blocks, on
+    /// every machine of the property test above.
+    #[test]
+    fn blocks_written_as_planned_are_the_whole_plan_written() {
+        let names = ["paper002-ac.json", "paper000-sixaxis-b.json", "paper000-sixaxis-m19.json", "head-bc.json"];
+        for name in names {
+            let (m, chain) = machine(name);
+            let mut rows = pass(50, 40.0, 150.0, 4.0, m.spindle.is_some());
+            rows.extend(pass(30, 20.0, -90.0, 2.0, m.spindle.is_some()));
+            let s = Settings { tol: 0.002, ..Settings::default() };
+            let posted = post(&rows, "t", &m, &chain, &s, vec!["c".into()]).expect("posts");
+            let allowance = rounding_allowance(&rows, &chain, &m);
+            let d = m.program.decimals;
+            let opts = plan::Options {
+                tol: s.tol - allowance,
+                angle_tol: (s.angle_tol * ANGLE_MARGIN
+                    - 0.5 * 10f64.powi(-(d.rotary as i32)) * chain.rotaries().len() as f64)
+                    .to_radians(),
+                spindle_tol: s.spindle_tol * SPINDLE_MARGIN,
+                tcp: m.program.tcp,
+                interpolate_singular: m.singular == camkit::doc::machine::SingularRule::Interpolate,
+            };
+            let (steps, stats) = plan::plan(&rows, &planning(&m, &chain), &opts).expect("plans");
+            assert!(stats.inserted > 0, "{name}: {stats:?}");
+            let wopts = nc::WriteOptions { rotary_radius: s.rotary_radius, comments: vec!["c".into()] };
+            let (whole, _) = nc::write(&steps, &m, &chain, &wopts).expect("writes");
+            assert!(posted.text == whole, "{name}: the streamed program differs from the whole plan written");
+            assert_eq!(posted.plan, stats, "{name}");
+        }
     }
 
     /// The read-back check runs chunks in parallel: the same figures on one thread as on four,

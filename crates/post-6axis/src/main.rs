@@ -15,7 +15,7 @@ use camkit::report::Report;
 use camkit::table::meaning::{self, Meaning};
 use camkit::table::{self, Col, WriteOptions};
 use clap::Parser;
-use post_6axis::{Settings, cl_rows, collision, judge, link, plot, post, readback};
+use post_6axis::{ClReader, Settings, collision, judge, link, plot, post, readback};
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Instant;
@@ -222,14 +222,33 @@ fn run(args: Args) -> Result<()> {
         table::write(&mut out, &t, &WriteOptions::default())?;
         return finish(out, &args, report);
     }
-    let t = table::read(&input, &[Col::X, Col::Y])?;
-    if let Meaning::StylusCentre(r) = meaning::of(&t, &input.name)? {
-        return Err(Error::input(format!(
-            "the stream's x,y,z are the centres of a stylus of radius {r} mm (column point = stylus-centre), not tool tips: the program would cut {r} mm in the air; run tool-attitude on it first"
-        ))
-        .at(Location::file(&input.name).line(t.rows[0].line).field(meaning::POINT)));
-    }
-    let (rows, normalised) = cl_rows(&t, &input.name, &chain, &machine, settings.feed, settings.tol)?;
+    // The rows as CL rows, read as they come: the table's rows are never held.
+    let mut meaning = None;
+    let mut reader = None;
+    let mut rows = Vec::new();
+    let schema = table::read_each(&input, &[Col::X, Col::Y], |schema, row| {
+        let check = meaning.get_or_insert_with(|| meaning::Check::new(schema));
+        check.row(&row, &input.name)?;
+        if let Meaning::StylusCentre(r) = check.meaning() {
+            return Err(Error::input(format!(
+                "the stream's x,y,z are the centres of a stylus of radius {r} mm (column point = stylus-centre), not tool tips: the program would cut {r} mm in the air; run tool-attitude on it first"
+            ))
+            .at(Location::file(&input.name).line(row.line).field(meaning::POINT)));
+        }
+        let r = match &mut reader {
+            Some(r) => r,
+            None => reader.insert(ClReader::new(schema, &input.name, &chain, &machine, settings.feed, settings.tol)?),
+        };
+        rows.push(r.row(&row)?);
+        Ok(())
+    })?;
+    let normalised = match reader {
+        Some(r) => r.normalised,
+        None => {
+            ClReader::new(&schema, &input.name, &chain, &machine, settings.feed, settings.tol)?;
+            return Err(Error::input("no rows: nothing to post").at(Location::file(&input.name)));
+        }
+    };
     if normalised > 0 {
         cli::warn(&format!("{normalised} tool axes were not unit vectors (within 1e-3): normalised"));
     }
@@ -263,6 +282,7 @@ fn run(args: Args) -> Result<()> {
     let rows = match &job {
         Some(j) => {
             let linked = link::Linker::new(j, walls.as_ref(), solid_ref, &input.name)?.link(&rows)?;
+            drop(rows);
             report.set("link_seconds", link_started.elapsed().as_secs_f64());
             comments.push(format!(
                 "setup {}: tool T{} from {}, clearance Z{} safe Z{} approach {} mm",
@@ -387,6 +407,7 @@ fn collide(
     let program = read_axes("written program", text)?;
     let reading = readback::Reading::new(machine, chain);
     let poses = readback::poses(&program, &reading);
+    drop(program);
     let check = collision::Check { job, walls, solid };
     let started = Instant::now();
     let progress = args.io.progress(poses.len() as u64, "checking against the stock");

@@ -6,7 +6,7 @@
 
 use camkit::geom::dist::point_arc;
 use camkit::geom::{Arc2, P2, P3, Plane, V3};
-use camkit::kinematics::{Chain, Joints, M3, Solver, principal_deg};
+use camkit::kinematics::{Chain, Choice, Joints, M3, Solver, principal_deg};
 
 /// An arc of the toolpath in the workpiece frame: from the previous row's tip to this row's,
 /// about `centre` (in the plane's (u, v) coordinates, [`Plane::split`]), turning counter-clockwise
@@ -302,19 +302,31 @@ fn lerp_joints(a: &Joints, b: &Joints, t: f64) -> Joints {
     }
 }
 
-/// Poses for every row, before linearisation: the sequence [`crate::branch::choose`] finds, the
-/// primary angle interpolated through singular runs, the spindle orientation continuous within a
-/// pass and unwound where the rotary axes may turn freely.
-fn poses(rows: &[Cl], m: &Machine, opts: &Options, stats: &mut Stats) -> Result<Vec<Step>, PlanError> {
+/// The sequence of solutions [`crate::branch::choose`] finds for every row, the primary angle
+/// interpolated through singular runs.
+fn choices(rows: &[Cl], m: &Machine, opts: &Options, stats: &mut Stats) -> Result<Vec<Choice>, PlanError> {
     let chosen = crate::branch::choose(rows, m, opts)?;
     stats.unwinds += chosen.unwinds;
     let mut choices = chosen.choices;
     if m.chain().rotaries().len() == 2 {
         interpolate_singular_runs(rows, m, opts, &mut choices)?;
     }
-    let mut steps = Vec::with_capacity(rows.len());
+    Ok(choices)
+}
+
+/// The pose of every row in order, before linearisation, handed to `each`: its chosen solution,
+/// the spindle orientation continuous within a pass and unwound where the rotary axes may turn
+/// freely. Figures are counted in `stats` if given.
+fn poses(
+    rows: &[Cl],
+    choices: &[Choice],
+    m: &Machine,
+    opts: &Options,
+    mut stats: Option<&mut Stats>,
+    mut each: impl FnMut(Step) -> Result<(), PlanError>,
+) -> Result<(), PlanError> {
     let mut sigma: Option<f64> = None;
-    for (i, (row, c)) in rows.iter().zip(&choices).enumerate() {
+    for (i, (row, c)) in rows.iter().zip(choices).enumerate() {
         let (xyz, frame) = m.linear(&row.tip, &c.rot, opts.tcp);
         m.check_travel(&xyz).map_err(|message| PlanError { row: i, message, unreachable: true })?;
         let joints = Joints { xyz, rot: c.rot };
@@ -323,14 +335,18 @@ fn poses(rows: &[Cl], m: &Machine, opts: &Options, stats: &mut Stats) -> Result<
             && let Some(sg) = sigma.filter(|sg| sg.abs() >= 360.0)
         {
             sigma = Some(principal_deg(sg));
-            stats.spindle_unwinds += 1;
+            if let Some(st) = stats.as_deref_mut() {
+                st.spindle_unwinds += 1;
+            }
         }
-        if c.singular {
-            stats.singular_rows += 1;
+        if c.singular
+            && let Some(st) = stats.as_deref_mut()
+        {
+            st.singular_rows += 1;
             let axis = frame.column(2).into_owned();
-            stats.pose_axis_error = stats.pose_axis_error.max(angle_between(&axis, &row.axis));
+            st.pose_axis_error = st.pose_axis_error.max(angle_between(&axis, &row.axis));
         }
-        steps.push(Step {
+        each(Step {
             joints,
             spindle: if row.s.is_some() { sigma } else { None },
             cl: *row,
@@ -338,9 +354,9 @@ fn poses(rows: &[Cl], m: &Machine, opts: &Options, stats: &mut Stats) -> Result<
             inserted: false,
             singular: c.singular,
             arc: None,
-        });
+        })?;
     }
-    Ok(steps)
+    Ok(())
 }
 
 /// Inside each run of singular rows of a pass, the primary angle goes linearly (by tip path
@@ -670,21 +686,34 @@ fn linearise(
     linearise(m, opts, &mid, b, depth + 1, out, stats)
 }
 
+/// Plans the blocks for CL rows on a machine, handing each to `emit` in order as soon as the
+/// next row's blocks no longer depend on it (the last block planned is where linearisation of
+/// the next segment starts): never the whole program's blocks at once. Every pose is checked
+/// against the travel limits before the first block is planned.
+pub fn plan_each(rows: &[Cl], m: &Machine, opts: &Options, emit: &mut dyn FnMut(&Step)) -> Result<Stats, PlanError> {
+    let mut stats = Stats { rows: rows.len(), ..Stats::default() };
+    let choices = choices(rows, m, opts, &mut stats)?;
+    poses(rows, &choices, m, opts, Some(&mut stats), |_| Ok(()))?;
+    let mut out: Vec<Step> = Vec::new();
+    poses(rows, &choices, m, opts, None, |step| {
+        match out.last().copied() {
+            Some(a) if !step.cl.rapid => match &step.cl.arc {
+                Some(arc) => plan_arc(m, opts, &a, &step, arc, &mut out, &mut stats)?,
+                None => linearise(m, opts, &a, &step, 0, &mut out, &mut stats)?,
+            },
+            _ => out.push(step),
+        }
+        let done = out.len() - 1;
+        out.drain(..done).for_each(|s| emit(&s));
+        Ok(())
+    })?;
+    out.iter().for_each(emit);
+    Ok(stats)
+}
+
 /// Plans the blocks for CL rows on a machine.
 pub fn plan(rows: &[Cl], m: &Machine, opts: &Options) -> Result<(Vec<Step>, Stats), PlanError> {
-    let mut stats = Stats { rows: rows.len(), ..Stats::default() };
-    let steps = poses(rows, m, opts, &mut stats)?;
-    let mut out = Vec::with_capacity(steps.len() + steps.len() / 8);
-    for (i, step) in steps.iter().enumerate() {
-        if i == 0 || step.cl.rapid {
-            out.push(*step);
-            continue;
-        }
-        let a = *out.last().expect("a previous block");
-        match &step.cl.arc {
-            Some(arc) => plan_arc(m, opts, &a, step, arc, &mut out, &mut stats)?,
-            None => linearise(m, opts, &a, step, 0, &mut out, &mut stats)?,
-        }
-    }
+    let mut out = Vec::with_capacity(rows.len() + rows.len() / 8);
+    let stats = plan_each(rows, m, opts, &mut |s| out.push(*s))?;
     Ok((out, stats))
 }

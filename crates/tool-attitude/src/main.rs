@@ -5,13 +5,13 @@ use camkit::cli::{self, IoArgs};
 use camkit::doc::{Tool, ToolKind};
 use camkit::error::{Error, Location, Result};
 use camkit::geom::{P3, V3};
-use camkit::io::{Input, Output, Stream, write_atomic};
+use camkit::io::{Input, Stream, write_atomic};
 use camkit::json::{at_value, field_error};
 use camkit::model::Model;
 use camkit::report::Report;
 use camkit::svg::relief;
 use camkit::table::meaning::{self, Meaning};
-use camkit::table::{self, Col, Field, Table, WriteOptions};
+use camkit::table::{self, Col, Field, Schema, Table, WriteOptions};
 use clap::{Parser, ValueEnum};
 use rayon::prelude::*;
 use std::path::PathBuf;
@@ -107,6 +107,10 @@ struct Args {
     /// axis's tilt from +z (degrees; by z for one fixed axis), the axis drawn at evenly spaced rows.
     #[arg(long, value_name = "FILE")]
     svg: Option<PathBuf>,
+    /// Rows placed at a time (whole passes in the tilt modes): a test knob, the output is the
+    /// same for any value.
+    #[arg(long, hide = true, default_value_t = CHUNK, value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(1..))]
+    chunk_rows: usize,
 }
 
 fn after_help() -> String {
@@ -196,100 +200,117 @@ fn setup(args: &Args, tool: &Tool, tool_file: &str) -> Result<Setup> {
     })
 }
 
-/// Column number (1-based) and name of a column in the table, for error locations.
-fn column_of(t: &Table, name: &str) -> u64 {
-    t.schema
+/// Column number (1-based) and name of a column of `schema`, for error locations.
+fn column_of(schema: &Schema, name: &str) -> u64 {
+    schema
         .fields
         .iter()
         .position(|f| match f {
             Field::Known(c) => table::columns::spec(*c).name == name,
-            Field::Extra(i) => t.schema.extra_names[*i] == name,
+            Field::Extra(i) => schema.extra_names[*i] == name,
         })
         .map_or(0, |p| p as u64 + 1)
 }
 
 /// Reads the unit normal of a row from typed or named columns; refuses zero or non-unit ones.
-fn unit_normal(v: V3, t: &Table, file: &str, line: u64, col: &str) -> Result<V3> {
+fn unit_normal(v: V3, schema: &Schema, file: &str, line: u64, col: &str) -> Result<V3> {
     let len = v.norm();
     if (len - 1.0).abs() > camkit::tol::UNIT_VECTOR_SLACK {
         return Err(Error::input(format!(
             "the normal ({}, {}, {}) is not a unit vector (length {len})",
             v.x, v.y, v.z
         ))
-        .at(Location::file(file).line(line).column(column_of(t, col)).field(col)));
+        .at(Location::file(file).line(line).column(column_of(schema, col)).field(col)));
     }
     Ok(v / len)
 }
 
-/// Contacts of every row (feed still zero) and the rows' pass starts.
-fn contacts(t: &Table, file: &str, model: Option<&Model>, needs_second: bool) -> Result<Vec<Contact>> {
-    let names = ["p2x", "p2y", "p2z", "n2x", "n2y", "n2z"];
-    let idx: Vec<Option<usize>> = names.iter().map(|n| t.schema.extra_index(n)).collect();
-    if needs_second {
-        if let Some(k) = idx.iter().position(Option::is_none) {
-            return Err(Error::input(format!(
-                "missing column `{}`: the flat-type tool needs the two-surface stream (stylus-trace --mode two-surface)",
-                names[k]
-            ))
-            .at(Location::file(file).line(1)));
-        }
-    }
-    let (s1, s2) = (t.schema.extra_index("surface"), t.schema.extra_index("surface2"));
-    let mut out = Vec::with_capacity(t.rows.len());
-    for row in &t.rows {
-        let (Some(point), Some(n)) = (row.contact, row.normal) else {
-            let col = if row.contact.is_none() { "px" } else { "nx" };
-            return Err(Error::input("empty contact point or normal: every row needs px..pz and nx..nz")
-                .at(Location::file(file).line(row.line).column(column_of(t, col)).field(col)));
-        };
-        let normal = unit_normal(n, t, file, row.line, "nx")?;
+/// Names of the second contact's columns in a two-surface stream.
+const SECOND: [&str; 6] = ["p2x", "p2y", "p2z", "n2x", "n2y", "n2z"];
+
+/// Reads the contacts of rows of one schema (feed still zero): where the columns are.
+struct ContactReader {
+    schema: Schema,
+    second: Option<[usize; 6]>,
+    surfaces: (Option<usize>, Option<usize>),
+}
+
+impl ContactReader {
+    /// The reader for rows of `schema`; the flat-type tool (`needs_second`) needs the two-surface
+    /// columns.
+    fn new(schema: &Schema, file: &str, needs_second: bool) -> Result<ContactReader> {
+        let idx: Vec<Option<usize>> = SECOND.iter().map(|n| schema.extra_index(n)).collect();
         let second = if needs_second {
-            let mut v = [0.0; 6];
-            for (k, slot) in v.iter_mut().enumerate() {
-                let i = idx[k].expect("checked above");
-                let text = row.extra.get(i).map_or("", String::as_str);
-                *slot = camkit::num::parse_finite(text).map_err(|e| {
-                    Error::input(e.message(text))
-                        .at(Location::file(file).line(row.line).column(column_of(t, names[k])).field(names[k]))
-                })?;
+            if let Some(k) = idx.iter().position(Option::is_none) {
+                return Err(Error::input(format!(
+                    "missing column `{}`: the flat-type tool needs the two-surface stream (stylus-trace --mode two-surface)",
+                    SECOND[k]
+                ))
+                .at(Location::file(file).line(1)));
             }
-            let n2 = unit_normal(V3::new(v[3], v[4], v[5]), t, file, row.line, "n2x")?;
-            Some((P3::new(v[0], v[1], v[2]), n2))
+            Some(std::array::from_fn(|k| idx[k].expect("checked above")))
         } else {
             None
         };
+        let surfaces = (schema.extra_index("surface"), schema.extra_index("surface2"));
+        Ok(ContactReader { schema: schema.clone(), second, surfaces })
+    }
+
+    /// The contact of one row (feed zero).
+    fn contact(&self, row: &table::Row, file: &str, model: Option<&Model>) -> Result<Contact> {
+        let col = |name: &str| column_of(&self.schema, name);
+        let (Some(point), Some(n)) = (row.contact, row.normal) else {
+            let name = if row.contact.is_none() { "px" } else { "nx" };
+            return Err(Error::input("empty contact point or normal: every row needs px..pz and nx..nz")
+                .at(Location::file(file).line(row.line).column(col(name)).field(name)));
+        };
+        let normal = unit_normal(n, &self.schema, file, row.line, "nx")?;
+        let second = match &self.second {
+            Some(idx) => {
+                let mut v = [0.0; 6];
+                for (k, slot) in v.iter_mut().enumerate() {
+                    let text = row.extra.get(idx[k]).map_or("", String::as_str);
+                    *slot = camkit::num::parse_finite(text).map_err(|e| {
+                        Error::input(e.message(text))
+                            .at(Location::file(file).line(row.line).column(col(SECOND[k])).field(SECOND[k]))
+                    })?;
+                }
+                let n2 = unit_normal(V3::new(v[3], v[4], v[5]), &self.schema, file, row.line, "n2x")?;
+                Some((P3::new(v[0], v[1], v[2]), n2))
+            }
+            None => None,
+        };
         let surface =
             |i: Option<usize>| model.zip(i).and_then(|(m, i)| row.extra.get(i).and_then(|name| m.surface_index(name)));
-        out.push(Contact {
+        Ok(Contact {
             centre: row.pos,
             point,
             normal,
             second,
-            surfaces: (surface(s1), surface(s2)),
+            surfaces: (surface(self.surfaces.0), surface(self.surfaces.1)),
             feed: V3::zeros(),
-        });
+        })
     }
-    // Feed directions per pass from consecutive stylus centres.
-    let mut start = 0;
-    while start < t.rows.len() {
-        let path = t.rows[start].path;
-        let end = (start..t.rows.len()).find(|&i| t.rows[i].path != path).unwrap_or(t.rows.len());
-        let centres: Vec<P3> = out[start..end].iter().map(|c| c.centre).collect();
-        match pose::feed_directions(&centres) {
-            Ok(f) => f.into_iter().enumerate().for_each(|(k, d)| out[start + k].feed = d),
-            Err(k) => {
-                let line = t.rows[start + k].line;
-                let what = if end - start < 2 {
-                    format!("path {path} has {} row: the feed direction needs at least two", end - start)
-                } else {
-                    "this row repeats the previous position: no feed direction".into()
-                };
-                return Err(Error::input(what).at(Location::file(file).line(line)));
-            }
+}
+
+/// Sets the feed directions of one pass's contacts from consecutive stylus centres (`rows`, the
+/// pass's rows, name the line of a row that has none).
+fn set_feed(contacts: &mut [Contact], rows: &[table::Row], file: &str) -> Result<()> {
+    let centres: Vec<P3> = contacts.iter().map(|c| c.centre).collect();
+    match pose::feed_directions(&centres) {
+        Ok(f) => {
+            contacts.iter_mut().zip(f).for_each(|(c, d)| c.feed = d);
+            Ok(())
         }
-        start = end;
+        Err(k) => {
+            let what = if rows.len() < 2 {
+                format!("path {} has {} row: the feed direction needs at least two", rows[0].path, rows.len())
+            } else {
+                "this row repeats the previous position: no feed direction".into()
+            };
+            Err(Error::input(what).at(Location::file(file).line(rows[k].line)))
+        }
     }
-    Ok(out)
 }
 
 /// The fixed tool axis of `--axis`, unit; a zero, malformed or non-finite vector is a usage error.
@@ -329,7 +350,7 @@ fn run_fixed(args: &Args, tool: &Tool, tool_file: &str, axis: V3, started: Insta
     let progress = args.io.progress(0, "placing tips");
     let mut placed = Placed { kept: args.svg.is_some().then(Vec::new), ..Placed::default() };
     let mut stream: Option<FixedStream> = None;
-    let mut chunk = Vec::with_capacity(CHUNK);
+    let mut chunk = Vec::with_capacity(args.chunk_rows.min(CHUNK));
     table::read_each(&input, &[Col::X, Col::Y, Col::Z], |schema, row| {
         let s = match &mut stream {
             Some(s) => s,
@@ -351,9 +372,9 @@ fn run_fixed(args: &Args, tool: &Tool, tool_file: &str, axis: V3, started: Insta
         }
         placed.rows += 1;
         chunk.push(row);
-        if chunk.len() == CHUNK {
+        if chunk.len() == args.chunk_rows {
             s.place(&mut chunk, &mut placed, &mut out)?;
-            progress.inc(CHUNK as u64);
+            progress.inc(args.chunk_rows as u64);
         }
         Ok(())
     })?;
@@ -391,7 +412,7 @@ fn run_fixed(args: &Args, tool: &Tool, tool_file: &str, axis: V3, started: Insta
     out.commit()
 }
 
-/// Rows placed at a time by the fixed-axis stream (in parallel within a chunk).
+/// Rows placed at a time (in parallel within a chunk) by default.
 const CHUNK: usize = 1 << 14;
 
 /// How the fixed-axis stream places a tip: the axis, the ball's radius, the part checked for
@@ -498,85 +519,49 @@ fn run(args: Args) -> Result<()> {
     let part = load_part(&args, &tool, setup.length)?;
     let model = part.as_ref().map(|p| &p.model);
     let input = Input::open(&args.io.input)?;
-    let mut t = table::read(&input, &[Col::X, Col::Y, Col::Z, Col::Px, Col::Py, Col::Pz, Col::Nx, Col::Ny, Col::Nz])?;
-    if t.rows.is_empty() {
+    let needs_second = matches!(setup.shape, Shape::FlatType { .. });
+    let ctx =
+        Tilting { setup: &setup, part: part.as_ref(), model, file: &input.name, ball: tool.kind == ToolKind::Ball };
+    let progress = args.io.progress(0, "solving attitudes");
+    let mut out = Stream::new(args.io.output.as_deref())?;
+    let mut stream: Option<TiltStream> = None;
+    let mut kept = args.svg.is_some().then(Vec::new);
+    table::read_each(
+        &input,
+        &[Col::X, Col::Y, Col::Z, Col::Px, Col::Py, Col::Pz, Col::Nx, Col::Ny, Col::Nz],
+        |schema, row| {
+            let first = stream.is_none();
+            let s = match &mut stream {
+                Some(s) => s,
+                None => stream.insert(TiltStream::new(schema, &ctx, needs_second, &args, kept.take())?),
+            };
+            if ctx.ball {
+                s.check.row(&row, ctx.file)?;
+                if first {
+                    check_stylus(s.check.meaning(), ctx.file, &tool, &tool_input.name)
+                        .map_err(|e| at_value(&tool_input, e))?;
+                }
+            }
+            let before = s.solved.rows;
+            s.push(row, &ctx, &mut out)?;
+            progress.inc((s.solved.rows - before) as u64);
+            Ok(())
+        },
+    )?;
+    let Some(mut s) = stream else {
         return Err(Error::input("no rows: the feed direction needs at least two rows of a path")
             .at(Location::file(&input.name)));
-    }
-    if tool.kind == ToolKind::Ball {
-        check_stylus(meaning::of(&t, &input.name)?, &input.name, &tool, &tool_input.name)
-            .map_err(|e| at_value(&tool_input, e))?;
-    }
-    let needs_second = matches!(setup.shape, Shape::FlatType { .. });
-    let cs = contacts(&t, &input.name, model, needs_second)?;
-    if needs_second && model.is_some() && cs.iter().any(|c| c.surfaces.0.is_none() || c.surfaces.1.is_none()) {
-        cli::warn("rows without `surface`/`surface2` names of the model: their flat-type axis uses the tangent planes");
-    }
-    let solved_at = Instant::now();
-    let progress = args.io.progress(cs.len() as u64, "solving attitudes");
-    let results: Vec<std::result::Result<Attitude, RowError>> = cs
-        .par_iter()
-        .map(|c| {
-            let a = attitude(&setup, c, part.as_ref());
-            progress.inc(1);
-            a
-        })
-        .collect();
+    };
+    s.end_pass(&ctx)?;
+    s.solve(&ctx, &mut out)?;
     progress.finish();
-    let seconds_solve = solved_at.elapsed().as_secs_f64();
-    let mut poses = Vec::with_capacity(results.len());
-    for (k, r) in results.into_iter().enumerate() {
-        match r {
-            Ok(a) => poses.push(a),
-            Err(e) => {
-                let loc = Location::file(&input.name).line(t.rows[k].line);
-                return Err(match e {
-                    RowError::Flat(tool_attitude::flat_type::FlatError::NoContact) => {
-                        Error::check(e.to_string()).at(loc)
-                    }
-                    _ => Error::input(e.to_string()).at(loc),
-                });
-            }
-        }
+    let TiltStream { solved: d, writer, marker, .. } = s;
+    writer.finish(&mut out)?;
+    if d.checks.worst() > POSE_CHECK {
+        return Err(Error::check(format!("a pose failed its own check by {:e} (a bug)", d.checks.worst())));
     }
-    let checks = self_check(&setup, &cs, &poses);
-    if checks.worst > POSE_CHECK {
-        return Err(Error::check(format!("a pose failed its own check by {:e} (a bug)", checks.worst)));
-    }
-    // Output table.
-    let nonrotating = matches!(setup.shape, Shape::Cylinder { .. } | Shape::FlatType { .. });
-    t.schema.add(&[Col::I, Col::J, Col::K]);
-    if nonrotating {
-        t.schema.add(&[Col::S]);
-    }
-    let c_tilt = t.add_extra_column("tilt");
-    let c_edge = matches!(setup.shape, Shape::Cylinder { .. }).then(|| t.add_extra_column("r_edge"));
-    let c_ac =
-        matches!(setup.shape, Shape::FlatMill { .. }).then(|| (t.add_extra_column("ac_a"), t.add_extra_column("ac_c")));
-    let c_gap = needs_second.then(|| t.add_extra_column("flank_gap"));
-    let c_gouge = part.is_some().then(|| t.add_extra_column("gouge"));
-    let mut gouging = Vec::new();
-    for (k, (row, a)) in t.rows.iter_mut().zip(&poses).enumerate() {
-        row.pos = a.pose.tip;
-        row.axis = a.pose.axis;
-        row.s = if nonrotating { a.pose.spindle() } else { None };
-        row.extra[c_tilt] = num(a.tilt.to_degrees());
-        if let Some(i) = c_edge {
-            row.extra[i] = a.edge_radius.map(num).unwrap_or_default();
-        }
-        if let (Some((ia, ic)), Some((va, vc))) = (c_ac, a.machine) {
-            row.extra[ia] = num(va);
-            row.extra[ic] = num(vc);
-        }
-        if let (Some(i), Some(g)) = (c_gap, a.flank_gap) {
-            row.extra[i] = num(g.to_degrees());
-        }
-        if let (Some(i), Some(g)) = (c_gouge, a.gouge) {
-            row.extra[i] = num(g);
-            if g > setup.gouge_tol {
-                gouging.push(k);
-            }
-        }
+    if needs_second && model.is_some() && d.unnamed_surfaces {
+        cli::warn("rows without `surface`/`surface2` names of the model: their flat-type axis uses the tangent planes");
     }
     let mut report = Report::new("tool-attitude");
     if let Some(m) = &model {
@@ -585,40 +570,236 @@ fn run(args: Args) -> Result<()> {
     }
     report
         .set("tool", &tool)
-        .set("rows", t.rows.len())
-        .set("paths", t.passes().count())
+        .set("rows", d.rows)
+        .set("paths", d.paths)
         .set("tilt_deg", setup.tilt.to_degrees())
         .set("tilt_range_deg", [setup.range.0.to_degrees(), setup.range.1.to_degrees()])
-        .set("adjusted_rows", poses.iter().filter(|a| a.adjusted).count())
-        .set("gouge_rows", gouging.len())
-        .set("gouge_lines", gouging.iter().take(20).map(|&k| t.rows[k].line).collect::<Vec<_>>())
+        .set("adjusted_rows", d.adjusted)
+        .set("gouge_rows", d.gouge_rows)
+        .set("gouge_lines", &d.gouge_lines)
         .set("gouge_tol_mm", setup.gouge_tol)
-        .set("largest_gouge_mm", poses.iter().filter_map(|a| a.gouge).fold(0.0, f64::max))
+        .set("largest_gouge_mm", d.largest_gouge)
         .set("gouge_check", part.as_ref().map(|_| "body"))
         .set("gouge_chord_mm", part.as_ref().map(Part::chord_error))
-        .set("largest_axis_unit_error", checks.unit)
-        .set("largest_tilt_error_rad", checks.tilt)
-        .set("largest_tip_distance_error_mm", checks.tip)
+        .set("largest_axis_unit_error", d.checks.unit)
+        .set("largest_tilt_error_rad", d.checks.tilt)
+        .set("largest_tip_distance_error_mm", d.checks.tip)
         .set("seconds", started.elapsed().as_secs_f64())
-        .set("solve_seconds", seconds_solve)
-        .set("rows_per_second", t.rows.len() as f64 / seconds_solve.max(1e-9))
+        .set("solve_seconds", d.solve_seconds)
+        .set("rows_per_second", d.rows as f64 / d.solve_seconds.max(1e-9))
         .set("threads", rayon::current_num_threads());
-    let edges: Vec<f64> = poses.iter().filter_map(|a| a.edge_radius).collect();
-    if !edges.is_empty() {
-        report.set("r_edge_min_mm", edges.iter().copied().fold(f64::INFINITY, f64::min));
-        report.set("r_edge_max_mm", edges.iter().copied().fold(0.0, f64::max));
+    if let Some((lo, hi)) = d.edges {
+        report.set("r_edge_min_mm", lo);
+        report.set("r_edge_max_mm", hi);
     }
-    let gaps: Vec<f64> = poses.iter().filter_map(|a| a.flank_gap).collect();
-    if !gaps.is_empty() {
-        report.set("flank_gap_min_deg", gaps.iter().copied().fold(f64::INFINITY, f64::min).to_degrees());
-        let corrections = poses.iter().map(|a| a.tilt.abs()).fold(0.0, f64::max);
-        report.set("largest_axis_from_bisector_deg", corrections.to_degrees());
+    if let Some(gap) = d.least_gap {
+        report.set("flank_gap_min_deg", gap.to_degrees());
+        report.set("largest_axis_from_bisector_deg", d.largest_correction.to_degrees());
     }
     if let Some(path) = &args.io.report {
         report.write(path)?;
     }
-    let largest = poses.iter().filter_map(|a| a.gouge).fold(0.0, f64::max);
-    deliver(&args, &mut t, &input.name, model, &gouging, setup.gouge_tol, largest)
+    let first = d.gouge_lines.first().map(|&line| (line, d.gouge_rows));
+    refuse_gouges(&args, &input.name, first, setup.gouge_tol, d.largest_gouge)?;
+    if let (Some(path), Some(rows)) = (&args.svg, d.kept) {
+        plot(path, &Table { schema: marker.schema, rows }, &input.name, model)?;
+    }
+    out.commit()
+}
+
+/// What the tilt modes' stream solves with: the setup, the part (gouge checks), the model
+/// (surface names), the input's name, and whether the tool is a ball (stylus radius checked).
+struct Tilting<'a> {
+    setup: &'a Setup,
+    part: Option<&'a Part>,
+    model: Option<&'a Model>,
+    file: &'a str,
+    ball: bool,
+}
+
+/// The tilt modes' stream: rows gathered pass by pass (a row's feed direction needs its
+/// neighbours), whole passes solved in parallel once `chunk` rows are waiting, written in order.
+struct TiltStream {
+    reader: ContactReader,
+    check: meaning::Check,
+    /// The rows and contacts of the pass being read.
+    pass: Vec<table::Row>,
+    contacts: Vec<Contact>,
+    /// Whole passes waiting to be solved, their feed directions set.
+    ready: Vec<table::Row>,
+    ready_contacts: Vec<Contact>,
+    chunk: usize,
+    cols: OutColumns,
+    marker: meaning::TipMarker,
+    writer: table::RowWriter,
+    solved: Solved,
+}
+
+/// Where the written values go in a row of the output schema.
+struct OutColumns {
+    extras: usize,
+    nonrotating: bool,
+    tilt: usize,
+    edge: Option<usize>,
+    ac: Option<(usize, usize)>,
+    gap: Option<usize>,
+    gouge: Option<usize>,
+}
+
+/// The stream's figures so far.
+#[derive(Default)]
+struct Solved {
+    rows: usize,
+    paths: usize,
+    adjusted: usize,
+    gouge_rows: usize,
+    /// Lines of the first 20 rows that gouge.
+    gouge_lines: Vec<u64>,
+    largest_gouge: f64,
+    checks: Checks,
+    edges: Option<(f64, f64)>,
+    least_gap: Option<f64>,
+    largest_correction: f64,
+    unnamed_surfaces: bool,
+    solve_seconds: f64,
+    /// The rows written, for --svg.
+    kept: Option<Vec<table::Row>>,
+}
+
+impl TiltStream {
+    fn new(
+        schema: &Schema,
+        ctx: &Tilting,
+        needs_second: bool,
+        args: &Args,
+        kept: Option<Vec<table::Row>>,
+    ) -> Result<TiltStream> {
+        let reader = ContactReader::new(schema, ctx.file, needs_second)?;
+        let shape = ctx.setup.shape;
+        let nonrotating = matches!(shape, Shape::Cylinder { .. } | Shape::FlatType { .. });
+        let mut out = schema.clone();
+        out.add(&[Col::I, Col::J, Col::K]);
+        if nonrotating {
+            out.add(&[Col::S]);
+        }
+        let tilt = out.add_extra("tilt");
+        let edge = matches!(shape, Shape::Cylinder { .. }).then(|| out.add_extra("r_edge"));
+        let ac = matches!(shape, Shape::FlatMill { .. }).then(|| (out.add_extra("ac_a"), out.add_extra("ac_c")));
+        let gap = needs_second.then(|| out.add_extra("flank_gap"));
+        let gouge = ctx.part.is_some().then(|| out.add_extra("gouge"));
+        let cols = OutColumns { extras: out.extra_names.len(), nonrotating, tilt, edge, ac, gap, gouge };
+        let marker = meaning::TipMarker::new(&out);
+        let writer = table::RowWriter::new(&marker.schema, WriteOptions { decimals: args.decimals });
+        Ok(TiltStream {
+            reader,
+            check: meaning::Check::new(schema),
+            pass: Vec::new(),
+            contacts: Vec::new(),
+            ready: Vec::new(),
+            ready_contacts: Vec::new(),
+            chunk: args.chunk_rows,
+            cols,
+            marker,
+            writer,
+            solved: Solved { kept, ..Solved::default() },
+        })
+    }
+
+    /// Takes one row: its contact read, its pass ended where a new path starts, the waiting
+    /// passes solved once `chunk` rows wait.
+    fn push(&mut self, row: table::Row, ctx: &Tilting, out: &mut Stream) -> Result<()> {
+        if self.pass.last().is_some_and(|r| r.path != row.path) {
+            self.end_pass(ctx)?;
+            if self.ready.len() >= self.chunk {
+                self.solve(ctx, out)?;
+            }
+        }
+        self.contacts.push(self.reader.contact(&row, ctx.file, ctx.model)?);
+        self.pass.push(row);
+        Ok(())
+    }
+
+    /// Ends the pass being read: its feed directions set, it waits to be solved.
+    fn end_pass(&mut self, ctx: &Tilting) -> Result<()> {
+        if self.pass.is_empty() {
+            return Ok(());
+        }
+        set_feed(&mut self.contacts, &self.pass, ctx.file)?;
+        self.solved.paths += 1;
+        self.ready.append(&mut self.pass);
+        self.ready_contacts.append(&mut self.contacts);
+        Ok(())
+    }
+
+    /// Solves the waiting passes (in parallel), checks and writes them in order.
+    fn solve(&mut self, ctx: &Tilting, out: &mut Stream) -> Result<()> {
+        let started = Instant::now();
+        let results: Vec<std::result::Result<Attitude, RowError>> =
+            self.ready_contacts.par_iter().map(|c| attitude(ctx.setup, c, ctx.part)).collect();
+        self.solved.solve_seconds += started.elapsed().as_secs_f64();
+        let mut poses = Vec::with_capacity(results.len());
+        for (k, r) in results.into_iter().enumerate() {
+            match r {
+                Ok(a) => poses.push(a),
+                Err(e) => {
+                    let loc = Location::file(ctx.file).line(self.ready[k].line);
+                    return Err(match e {
+                        RowError::Flat(tool_attitude::flat_type::FlatError::NoContact) => {
+                            Error::check(e.to_string()).at(loc)
+                        }
+                        _ => Error::input(e.to_string()).at(loc),
+                    });
+                }
+            }
+        }
+        let d = &mut self.solved;
+        d.checks.add(&self_check(ctx.setup, &self.ready_contacts, &poses));
+        d.unnamed_surfaces |= self.ready_contacts.iter().any(|c| c.surfaces.0.is_none() || c.surfaces.1.is_none());
+        let c = &self.cols;
+        for (mut row, a) in self.ready.drain(..).zip(&poses) {
+            row.pos = a.pose.tip;
+            row.axis = a.pose.axis;
+            row.s = if c.nonrotating { a.pose.spindle() } else { None };
+            row.extra.resize(c.extras, String::new());
+            row.extra[c.tilt] = num(a.tilt.to_degrees());
+            if let Some(i) = c.edge {
+                row.extra[i] = a.edge_radius.map(num).unwrap_or_default();
+            }
+            if let (Some((ia, ic)), Some((va, vc))) = (c.ac, a.machine) {
+                row.extra[ia] = num(va);
+                row.extra[ic] = num(vc);
+            }
+            if let (Some(i), Some(g)) = (c.gap, a.flank_gap) {
+                row.extra[i] = num(g.to_degrees());
+            }
+            if let (Some(i), Some(g)) = (c.gouge, a.gouge) {
+                row.extra[i] = num(g);
+                if g > ctx.setup.gouge_tol {
+                    d.gouge_rows += 1;
+                    if d.gouge_lines.len() < 20 {
+                        d.gouge_lines.push(row.line);
+                    }
+                }
+            }
+            d.rows += 1;
+            d.adjusted += usize::from(a.adjusted);
+            d.largest_gouge = d.largest_gouge.max(a.gouge.unwrap_or(0.0));
+            if let Some(e) = a.edge_radius {
+                d.edges = Some(d.edges.map_or((e, e), |(lo, hi)| (lo.min(e), hi.max(e))));
+            }
+            if let Some(g) = a.flank_gap {
+                d.least_gap = Some(d.least_gap.map_or(g, |l| l.min(g)));
+            }
+            d.largest_correction = d.largest_correction.max(a.tilt.abs());
+            self.marker.row(&mut row);
+            self.writer.row(out, &row)?;
+            if let Some(kept) = &mut d.kept {
+                kept.push(row);
+            }
+        }
+        self.ready_contacts.clear();
+        Ok(())
+    }
 }
 
 /// The part of `--model` (none without): the model, the tool body of `length` and the model as
@@ -651,29 +832,6 @@ fn check_stylus(meaning: Meaning, file: &str, tool: &Tool, tool_file: &str) -> R
     Ok(())
 }
 
-/// Writes the table, after rows that gouge (indices `gouging`, the deepest `largest` mm) fail the
-/// run (exit 1, the first row named) or, with --allow-gouge, are warned of; the plot is drawn
-/// over `model`.
-fn deliver(
-    args: &Args,
-    t: &mut Table,
-    input: &str,
-    model: Option<&Model>,
-    gouging: &[usize],
-    tol: f64,
-    largest: f64,
-) -> Result<()> {
-    meaning::mark_tip(t);
-    let first = gouging.first().map(|&k| (t.rows[k].line, gouging.len()));
-    refuse_gouges(args, input, first, tol, largest)?;
-    if let Some(path) = &args.svg {
-        plot(path, t, input, model)?;
-    }
-    let mut out = Output::new(args.io.output.as_deref());
-    table::write(&mut out, t, &WriteOptions { decimals: args.decimals })?;
-    out.commit()
-}
-
 /// Rows that gouge (the first's line and their count, the deepest `largest` mm) fail the run
 /// (exit 1, the first row named) or, with --allow-gouge, are warned of.
 fn refuse_gouges(args: &Args, input: &str, gouging: Option<(u64, usize)>, tol: f64, largest: f64) -> Result<()> {
@@ -699,17 +857,32 @@ fn plot(path: &std::path::Path, t: &Table, input: &str, model: Option<&Model>) -
 const POSE_CHECK: f64 = 1e-9;
 
 /// Largest deviations of the written poses from what they promise, measured again.
+#[derive(Default)]
 struct Checks {
     unit: f64,
     tilt: f64,
     tip: f64,
-    worst: f64,
+}
+
+impl Checks {
+    /// The larger figures of both.
+    fn add(&mut self, other: &Checks) {
+        self.unit = self.unit.max(other.unit);
+        self.tilt = self.tilt.max(other.tilt);
+        self.tip = self.tip.max(other.tip);
+    }
+
+    /// The largest deviation; acos near 0 loses half the digits, so tiny tilts are left to the
+    /// sine-based tip check.
+    fn worst(&self) -> f64 {
+        self.unit.max(self.tip).max(if self.tilt < 1e-7 { 0.0 } else { self.tilt })
+    }
 }
 
 /// Measures every pose: axis of unit length; for the cylinder and ball the angle between axis
 /// and normal equal to |tilt| and the tip R (or the ball geometry) from the contact.
 fn self_check(setup: &Setup, cs: &[Contact], poses: &[Attitude]) -> Checks {
-    let mut c = Checks { unit: 0.0, tilt: 0.0, tip: 0.0, worst: 0.0 };
+    let mut c = Checks::default();
     for (ct, a) in cs.iter().zip(poses) {
         let axis = a.pose.axis;
         c.unit = c.unit.max((axis.norm() - 1.0).abs());
@@ -729,7 +902,5 @@ fn self_check(setup: &Setup, cs: &[Contact], poses: &[Attitude]) -> Checks {
             Shape::FlatType { .. } => {}
         }
     }
-    // acos near 0 loses half the digits: compare tilts through the sine instead when tiny.
-    c.worst = c.unit.max(c.tip).max(if c.tilt < 1e-7 { 0.0 } else { c.tilt });
     c
 }
