@@ -7,6 +7,10 @@
                                              half-angle 0.6 rad) on the grid stylus-trace scans: lines
                                              y = Y0 + k*PICK, points evenly at most STEP apart from X0 to X1;
                                              one thread; writes cutter,x,y,z and prints the seconds per cutter.
+  dropcutter-ocl.py at STL CUTTER IN.csv OUT.csv
+                                             the tips of one of those cutters at the x,y of every row of
+                                             IN.csv (stylus-trace's output), one thread; writes x,y,z and
+                                             prints the cutter, the points and the seconds.
 """
 import math
 import struct
@@ -83,11 +87,38 @@ def drop(stl, region, pick, step, out):
             f.write(f"{name},{x!r},{y!r},{z!r}\n")
 
 
+def drop_at(stl, name, points_csv, out):
+    import csv
+
+    import opencamlib as ocl
+    surf = ocl.STLSurf()
+    ocl.STLReader(stl, surf)
+    points = [(float(r["x"]), float(r["y"])) for r in csv.DictReader(open(points_csv))]
+    bdc = ocl.BatchDropCutter()
+    bdc.setSTL(surf)
+    cutter = CUTTERS[name](ocl)  # held here: setCutter keeps only a pointer to it
+    bdc.setCutter(cutter)
+    bdc.setThreads(1)
+    for x, y in points:
+        bdc.appendPoint(ocl.CLPoint(x, y, -100.0))
+    t0 = time.perf_counter()
+    bdc.run()
+    dt = time.perf_counter() - t0
+    cl = bdc.getCLPoints()
+    print(f"{name} {len(cl)} {dt:.6f}")
+    with open(out, "w") as f:
+        f.write("x,y,z\n")
+        for p in cl:
+            f.write(f"{p.x!r},{p.y!r},{p.z!r}\n")
+
+
 if __name__ == "__main__":
     if sys.argv[1] == "stl":
         make_stl(sys.argv[2], int(sys.argv[3]) if len(sys.argv) > 3 else 16)
     elif sys.argv[1] == "drop":
         region = [float(v) for v in sys.argv[3].split(",")]
         drop(sys.argv[2], region, float(sys.argv[4]), float(sys.argv[5]), sys.argv[6])
+    elif sys.argv[1] == "at":
+        drop_at(sys.argv[2], sys.argv[3], sys.argv[4], sys.argv[5])
     else:
         sys.exit(__doc__)

@@ -30,7 +30,7 @@ pub fn drop_lines(dc: &DropCutter, scan: &Scan, step: f64, tick: &(dyn Fn() + Sy
             for s in stations(line.s0, line.s1, step) {
                 let p = line.at(s, 0.0);
                 let found = dc.drop_near(p.x, p.y, near);
-                near = found.map(|d| d.contact);
+                near = found.map(|d| (d.contact, d.surface));
                 match found {
                     Some(d) => {
                         if !open {

@@ -234,7 +234,7 @@ impl Cutter {
     }
 
     /// f′(ρ) (infinite at the rim of a ball or bull-nose).
-    fn slope(&self, rho: f64) -> f64 {
+    pub(crate) fn slope(&self, rho: f64) -> f64 {
         match *self {
             Cutter::Cone { half_angle, .. } => 1.0 / half_angle.tan(),
             _ => {

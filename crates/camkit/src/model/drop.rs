@@ -320,16 +320,23 @@ impl DropCutter {
     }
 
     /// [`DropCutter::drop`] given a point `near` of the model (model frame; the contact of the
-    /// drop before, along a line): the tip touching it is a lower bound of the drop, so the search
-    /// prunes with it from the start (taken [`PLANE_MARGIN`] lower, so the best is never pruned
-    /// for rounding). The result is the drop's whatever the point.
-    pub fn drop_near(&self, u: f64, v: f64, near: Option<P3>) -> Option<Drop> {
+    /// drop before, along a line) and the surface holding it: the tip touching it is a lower bound
+    /// of the drop, so the search prunes with it from the start (taken [`PLANE_MARGIN`] lower, so
+    /// the best is never pruned for rounding), and that surface is searched first (its drop is
+    /// likely the best, which then prunes the others). The result is the drop's whatever the point.
+    pub fn drop_near(&self, u: f64, v: f64, near: Option<(P3, usize)>) -> Option<Drop> {
         let q = [u, v];
         let big_r = self.cutter.radius();
-        let start = near.map_or(f64::NEG_INFINITY, |p| {
+        let first = near.map_or(0, |n| n.1.min(self.parts.len().saturating_sub(1)));
+        let start = near.map_or(f64::NEG_INFINITY, |(p, _)| {
             let p = self.frame.to_frame(&p);
             let rho = (p.x - u).hypot(p.y - v);
-            if rho <= big_r { p.z - self.cutter.height(rho) - PLANE_MARGIN } else { f64::NEG_INFINITY }
+            // Lower by the sheets' TOL too: they leave out what is not TOL above the floor.
+            if rho <= big_r {
+                p.z - self.cutter.height(rho) - PLANE_MARGIN - super::sheet::TOL
+            } else {
+                f64::NEG_INFINITY
+            }
         });
         let shadow = |b: &Aabb| {
             let dx = (b.min.x - u).max(u - b.max.x).max(0.0);
@@ -337,7 +344,9 @@ impl DropCutter {
             dx * dx + dy * dy <= big_r * big_r
         };
         let mut best: Option<(Touch, V3, usize)> = None;
-        for (i, (part, bounds)) in self.parts.iter().enumerate() {
+        let order = std::iter::once(first).chain((0..self.parts.len()).filter(|&i| i != first));
+        for i in order.filter(|&i| i < self.parts.len()) {
+            let (part, bounds) = &self.parts[i];
             let floor = best.map_or(start, |(t, _, _)| t.tip.max(start));
             if !shadow(bounds) || bounds.max.z <= floor {
                 continue;
@@ -349,7 +358,10 @@ impl DropCutter {
                 }
             }
         }
-        let (t, n, surface) = best?;
+        let Some((t, n, surface)) = best else {
+            // Parts give nothing more than TOL above the floor: the start's own part may be one.
+            return if start.is_finite() { self.drop_near(u, v, None) } else { None };
+        };
         let normal = self.cutter.contact_normal(q, t.tip, &t.contact, n);
         Some(Drop {
             tip: self.frame.to_model(&P3::new(u, v, t.tip)),
@@ -580,7 +592,7 @@ mod tests {
             // Started from any point of the mesh (a corner, or a point inside a triangle), the
             // search finds the same drop.
             for near in [p(near.0 % 7, near.1 % 7), nalgebra::center(&tris[near.0 % 72][0], &tris[near.0 % 72][2])] {
-                let again = dc.drop_near(q[0], q[1], Some(near));
+                let again = dc.drop_near(q[0], q[1], Some((near, 0)));
                 prop_assert_eq!(again.is_some(), got.is_some());
                 if let (Some(a), Some(g)) = (again, got) {
                     prop_assert!((a.tip - g.tip).norm() <= 1e-12 * (1.0 + g.tip.z.abs()), "{:?} vs {:?}", a.tip, g.tip);

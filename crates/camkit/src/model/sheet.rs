@@ -13,9 +13,12 @@
 //! smooth piece that plane is within O(h²) of the surface, so few pieces of each size survive.
 //! Points of the surface give the lower bounds: each piece's middle, and where the segments from
 //! it to its corners and edges' middles leave the cutter's shadow (or a trimmed face, by
-//! bisection on its inside test). The search stops when no piece can give a tip more than
-//! [`TOL`] above the best point found, so the tip found is exact to [`TOL`] below (and a point of
-//! the surface, with its normal).
+//! bisection on its inside test). A trimmed face's boundary curves are dropped onto first, and a
+//! piece of the face on which g has no stationary point (`monotone`) is searched no further:
+//! what it holds in the face is on the boundary or on the pieces beside it (the piece across the
+//! boundary, bounded by the carrier beyond it, would otherwise be halved down along it). The
+//! search stops when no piece can give a tip more than [`TOL`] above the best point found, so the
+//! tip found is exact to [`TOL`] below (and a point of the surface, with its normal).
 
 use super::analytic::Analytic;
 use super::bvh::Aabb;
@@ -38,10 +41,15 @@ const MARGIN: f64 = 1e-11;
 /// Pieces searched per drop at most (never reached on the tests' surfaces; a guard).
 const MAX_NODES: usize = 200_000;
 
-/// Size (mm) below which a piece across a face's boundary is not halved further: its points
-/// inside come from its samples and the boundary's own drop, so a tip inside it is missed by at
-/// most (its curvature) · EDGE_PIECE² / 2 (4.5e-10 mm at curvature 1/mm).
-pub const EDGE_PIECE: f64 = 3e-5;
+/// Size (mm) below which a piece is left to its points: g changes by less than TOL across it
+/// (slopes below 10) except beside the rim of a ball or bull-nose, where f′ is unbounded and a
+/// rounding of ρ by 1e-15 mm already moves f by up to 1e-7 mm.
+const MIN_PIECE: f64 = 1e-10;
+
+/// Relative rounding (a few units in the last place) a box's distance from the axis is taken
+/// nearer by: beside the rim of a ball, where f′ is unbounded, a larger margin would keep pieces
+/// whose bound stands far above what they hold.
+const RHO_ROUND: f64 = 4e-15;
 
 /// Smallest n.z of a piece's middle normal for its plane to bound it.
 const SLAB_NZ: f64 = 0.02;
@@ -452,6 +460,85 @@ fn clipped_plane(c: &Cutter, q: [f64; 2], a: &P3, n: &V3, b: &Aabb) -> f64 {
     best
 }
 
+/// True when the piece's control points (whose hull holds it) lie beyond the shadow's tangent
+/// across the direction from the axis to the box's middle: nearer than the box's own distance
+/// where the piece runs along the shadow's rim (a box there reaches in while the piece does not).
+fn beyond(c: &Cutter, q: [f64; 2], net: &Bezier, b: &Aabb) -> bool {
+    let (dx, dy) = (0.5 * (b.min.x + b.max.x) - q[0], 0.5 * (b.min.y + b.max.y) - q[1]);
+    let len = dx.hypot(dy);
+    len > 0.0 && net.points().all(|p| ((p.x - q[0]) * dx + (p.y - q[1]) * dy) / len > c.radius())
+}
+
+/// True when g = z − f(ρ) has no stationary point on the piece, so that its largest value on the
+/// piece's part in a face lies on the face's boundary or on the piece's sides. Needs the piece's
+/// box in the open shadow (off the cone's tip, where f has no slope), and along s or along t the
+/// derivative of g of one sign all over it: ∂g/∂s = m·S_s with m = (−f′(ρ) d̂, 1), d̂ the
+/// direction from the axis, and S_s of a rational piece with positive weights is a positive
+/// combination of differences of control points of consecutive rows, any columns (the hodograph
+/// of a rational Bézier curve lies in the cone of its control points' differences, Floater 1992);
+/// so the sign holds when m·D has it for every such D and every m over the box.
+fn monotone(c: &Cutter, q: [f64; 2], net: &Bezier) -> bool {
+    let b = net.bounds();
+    let corners = [(b.min.x, b.min.y), (b.max.x, b.min.y), (b.max.x, b.max.y), (b.min.x, b.max.y)];
+    let far = corners.iter().map(|p| (p.0 - q[0]).hypot(p.1 - q[1])).fold(0.0, f64::max);
+    let near = (b.min.x - q[0]).max(q[0] - b.max.x).max(0.0).hypot((b.min.y - q[1]).max(q[1] - b.max.y).max(0.0));
+    if far >= c.radius() || (near == 0.0 && matches!(c, Cutter::Cone { .. })) {
+        return false;
+    }
+    let (lo, hi) = (c.slope(near), c.slope(far));
+    // The directions d̂ from the axis to the box: a sector (edges, middle, cosine of its
+    // half-width), or the whole circle when the axis passes through the box.
+    let sector = (near > 0.0).then(|| {
+        let (mx, my) = (0.5 * (b.min.x + b.max.x) - q[0], 0.5 * (b.min.y + b.max.y) - q[1]);
+        let len = mx.hypot(my);
+        let (cx, cy) = (mx / len, my / len);
+        let turn = corners.map(|p| {
+            let (x, y) = (p.0 - q[0], p.1 - q[1]);
+            (cx * y - cy * x).atan2(cx * x + cy * y)
+        });
+        let (a0, a1) = turn.iter().fold((0.0f64, 0.0f64), |(l, h), &a| (l.min(a), h.max(a)));
+        let rot = |a: f64| (cx * a.cos() - cy * a.sin(), cx * a.sin() + cy * a.cos());
+        (rot(a0), rot(a1), rot(0.5 * (a0 + a1)), (0.5 * (a1 - a0)).cos())
+    });
+    // The largest d̂·v over the directions.
+    let reach = |vx: f64, vy: f64| -> f64 {
+        let len = vx.hypot(vy);
+        match sector {
+            None => len,
+            Some((e0, e1, m, cosw)) if m.0 * vx + m.1 * vy < cosw * len => {
+                (e0.0 * vx + e0.1 * vy).max(e1.0 * vx + e1.1 * vy)
+            }
+            Some(_) => len,
+        }
+    };
+    // One sign of m·D for every difference D of `diffs` and every m.
+    let one_sign = |diffs: &mut dyn Iterator<Item = V3>| -> bool {
+        let (mut up, mut down, mut any) = (true, true, false);
+        for d in diffs {
+            any = true;
+            let (xhi, xlo) = (reach(d.x, d.y), -reach(-d.x, -d.y));
+            let least = d.z - if xhi >= 0.0 { hi * xhi } else { lo * xhi };
+            let most = d.z - if xlo <= 0.0 { hi * xlo } else { lo * xlo };
+            let eps = 1e-12 * d.norm() * (1.0 + hi);
+            up &= least > eps;
+            down &= most < -eps;
+            if !(up || down) {
+                return false;
+            }
+        }
+        any
+    };
+    let [p, r] = net.deg;
+    let pts: Vec<P3> = net.points().collect();
+    let at = |i: usize, j: usize| pts[i * (r + 1) + j];
+    let rows = (0..p).flat_map(|i| (0..=r).flat_map(move |j| (0..=r).map(move |l| (i, j, l))));
+    if one_sign(&mut rows.map(|(i, j, l)| at(i + 1, j) - at(i, l))) {
+        return true;
+    }
+    let cols = (0..r).flat_map(|j| (0..=p).flat_map(move |i| (0..=p).map(move |k| (j, i, k))));
+    one_sign(&mut cols.map(|(j, i, k)| at(i, j + 1) - at(k, j)))
+}
+
 impl Sheet {
     /// Pieces (axis frame) trimmed by `face` if given.
     pub fn new(pieces: Vec<Bezier>, face: Option<Trim>) -> Sheet {
@@ -478,10 +565,10 @@ impl Sheet {
         let dx = (b.min.x - q[0]).max(q[0] - b.max.x).max(0.0);
         let dy = (b.min.y - q[1]).max(q[1] - b.max.y).max(0.0);
         let rho = dx.hypot(dy);
-        if rho > c.radius() {
+        if rho > c.radius() || beyond(c, q, net, &b) {
             return f64::NEG_INFINITY;
         }
-        let top = b.max.z - c.height((rho - 1e-9).max(0.0));
+        let top = b.max.z - c.height(rho * (1.0 - RHO_ROUND));
         if !full {
             return top;
         }
@@ -510,7 +597,8 @@ impl Sheet {
     }
 
     /// The drop at `q` above `floor`: the touch and the surface's unit normal there (n.z ≥ 0,
-    /// towards the axis on a wall), or `None` when no point gives a tip above `floor`.
+    /// towards the axis on a wall), or `None` when no point gives a tip more than [`TOL`] above
+    /// `floor`.
     pub fn drop(&self, c: &Cutter, q: [f64; 2], floor: f64) -> Option<(Touch, V3)> {
         let big_r = c.radius();
         let mut heap = BinaryHeap::new();
@@ -554,7 +642,7 @@ impl Sheet {
                 let dx = (b.min.x - q[0]).max(q[0] - b.max.x).max(0.0);
                 let dy = (b.min.y - q[1]).max(q[1] - b.max.y).max(0.0);
                 let rho = dx.hypot(dy);
-                if rho > big_r || b.max.z - c.height((rho - 1e-9).max(0.0)) <= level(&best) {
+                if rho > big_r || b.max.z - c.height(rho * (1.0 - RHO_ROUND)) <= level(&best) {
                     continue;
                 }
                 let found = match e {
@@ -573,7 +661,7 @@ impl Sheet {
         let mut count = 0;
         while let Some(node) = heap.pop() {
             let floor_now = level(&best);
-            if node.bound <= floor_now + if best.is_some() { TOL } else { 0.0 } {
+            if node.bound <= floor_now + TOL {
                 break;
             }
             if !node.full {
@@ -626,22 +714,22 @@ impl Sheet {
                 take(found);
             }
             let floor_now = level(&best);
-            let limit = floor_now + if best.is_some() { TOL } else { 0.0 };
+            let limit = floor_now + TOL;
             if node.bound <= limit {
                 continue;
             }
             let r = node.rect;
             let dir = node.net.longest();
-            if (r[2 * dir + 1] - r[2 * dir]) < 1e-15 {
+            let b = node.net.bounds();
+            if (r[2 * dir + 1] - r[2 * dir]) < 1e-15 || (b.max - b.min).norm() < MIN_PIECE {
                 continue;
             }
-            // Across a face's boundary the bound holds the carrier beyond it: small pieces there
-            // are left to their points on the boundary (found by bisection).
-            if node.side == Side::Across {
-                let b = node.net.bounds();
-                if (b.max - b.min).norm() < EDGE_PIECE {
-                    continue;
-                }
+            // In a face, a piece where g has no stationary point gives nothing above what its
+            // sides (held by the pieces beside it) and the face's boundary (dropped onto first)
+            // give: the bound of a piece across the boundary holds the carrier beyond it, which
+            // would otherwise be halved down to nothing along the whole boundary.
+            if self.face.is_some() && monotone(c, q, &node.net) {
+                continue;
             }
             let (a, b) = node.net.split(dir);
             let midp = 0.5 * (r[2 * dir] + r[2 * dir + 1]);
@@ -775,6 +863,7 @@ mod tests {
     use crate::model::patch::BSpline;
     use crate::model::{Geometry, Model, Surface};
     use proptest::prelude::*;
+    use std::f64::consts::TAU;
 
     fn cutters() -> impl Strategy<Value = Cutter> {
         prop_oneof![
@@ -877,6 +966,87 @@ mod tests {
             let long = Analytic::Cylinder { point, axis, radius: r, from: -30.0, to: 30.0 };
             let endless = Analytic::Cylinder { point, axis, radius: r, from: f64::NEG_INFINITY, to: f64::INFINITY };
             against_closed_form(c, Geometry::Analytic(endless), analytic_pieces(&long).unwrap(), q)?;
+        }
+    }
+
+    /// A spherical cap (R5 about the origin, above a rim circle) under each cutter, its rim put
+    /// 10 µm beside the whole sphere's contact: with the contact just inside, the drop is the
+    /// closed form's to 1e-9 mm; just outside, it is the rim's highest tip (the rim sampled every
+    /// 1e-5 rad, then golden section about the best), and no sample of the cap (every 1e-3 rad
+    /// each way) stands above it. The pieces across the rim are what the search cannot halve
+    /// down to nothing: it must see that the cap gives nothing more than its rim there.
+    #[test]
+    fn contacts_beside_a_face_edge_are_exact() {
+        let rs = 5.0f64;
+        let sphere = Analytic::Sphere { centre: P3::origin(), radius: rs };
+        let cutters = [
+            Cutter::Flat { radius: 2.0 },
+            Cutter::Ball { radius: 2.0 },
+            Cutter::Bull { radius: 2.0, corner: 0.7 },
+            Cutter::Cone { radius: 2.0, half_angle: 1.0 },
+        ];
+        for c in cutters {
+            for q in [[2.6, 0.9], [-2.1, 1.7], [0.2, -3.3]] {
+                let whole = DropCutter::new(&one(Geometry::Analytic(sphere.clone())), c, V3::z())
+                    .unwrap()
+                    .drop(q[0], q[1])
+                    .unwrap();
+                let lat = whole.contact.z.atan2(whole.contact.coords.xy().norm());
+                for (side, d) in [("inside", -1e-5 / rs), ("outside", 1e-5 / rs)] {
+                    let rim_lat = lat + d;
+                    let (zc, rr) = (rs * rim_lat.sin(), rs * rim_lat.cos());
+                    let rim = Curve::Arc {
+                        centre: P3::new(0.0, 0.0, zc),
+                        x: V3::x(),
+                        y: V3::y(),
+                        radius: rr,
+                        t0: 0.0,
+                        t1: TAU,
+                    };
+                    // Its seam up to the pole, walked both ways (as CAD systems write a cap).
+                    let seam = Curve::Arc {
+                        centre: P3::origin(),
+                        x: V3::x(),
+                        y: V3::z(),
+                        radius: rs,
+                        t0: rim_lat,
+                        t1: FRAC_PI_2,
+                    };
+                    let lp = vec![(rim, true), (seam.clone(), true), (seam, false)];
+                    let face = Face::new(Carrier::Analytic(sphere.clone()), vec![lp], true);
+                    let place = Isometry3::identity();
+                    let sheet = Sheet::new(face_pieces(&face), Some(Trim::new(&face, &place)));
+                    let got = sheet.drop(&c, q, f64::NEG_INFINITY).map(|(t, _)| t.tip);
+                    let g = |p: P3| {
+                        let rho = (p.x - q[0]).hypot(p.y - q[1]);
+                        if rho <= c.radius() { p.z - c.height(rho) } else { f64::NEG_INFINITY }
+                    };
+                    if side == "inside" {
+                        let tip = got.unwrap();
+                        assert!((tip - whole.tip.z).abs() <= 1e-9, "{c:?} {q:?}: {tip} vs {}", whole.tip.z);
+                        continue;
+                    }
+                    let at = |a: f64| P3::new(rr * a.cos(), rr * a.sin(), zc);
+                    let n = 628_319;
+                    let k = (0..n).max_by(|&i, &j| g(at(i as f64 * 1e-5)).total_cmp(&g(at(j as f64 * 1e-5)))).unwrap();
+                    let a = golden_arg(|a| g(at(a)), (k as f64 - 1.0) * 1e-5, (k as f64 + 1.0) * 1e-5, 80);
+                    let edge = g(at(a));
+                    // The flat's contact is on its rim: just beyond it the cap is out of reach.
+                    let tip = got.unwrap_or(f64::NEG_INFINITY);
+                    assert!(tip == edge || (tip - edge).abs() <= 1e-9, "{c:?} {q:?}: {tip} vs the rim's {edge}");
+                    // The cap within 0.6 rad of the contact's longitude (the shadow is narrower).
+                    let mut cap = f64::NEG_INFINITY;
+                    let lon = whole.contact.y.atan2(whole.contact.x);
+                    for i in 0..=((FRAC_PI_2 - rim_lat) / 1e-3) as usize {
+                        let b = rim_lat + i as f64 * 1e-3;
+                        for j in 0..=1200 {
+                            let a = lon - 0.6 + j as f64 * 1e-3;
+                            cap = cap.max(g(P3::new(rs * b.cos() * a.cos(), rs * b.cos() * a.sin(), rs * b.sin())));
+                        }
+                    }
+                    assert!(cap <= tip + 1e-12, "{c:?} {q:?}: a sample of the cap {} above", cap - tip);
+                }
+            }
         }
     }
 
