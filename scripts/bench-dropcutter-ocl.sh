@@ -15,21 +15,10 @@ CELLS=${CELLS:-100}     # 20 000 triangles
 PICK=${PICK:-0.25}      # between lines (mm)
 STEP=${STEP:-0.1}       # along a line (mm)
 REGION=-3,23,-3,23
-mkdir -p "$WORK"
-if [ ! -x "$WORK/venv/bin/python" ]; then
-  python3 -m venv "$WORK/venv"
-fi
-"$WORK/venv/bin/pip" install -q opencamlib
-cargo build -q --release -p stylus-trace
-BIN=${CARGO_TARGET_DIR:-target}/release/stylus-trace
-PY="$WORK/venv/bin/python"
+. scripts/ocl-env.sh
 STL="$WORK/dropcut-$CELLS.stl"
 "$PY" scripts/dropcutter-ocl.py stl "$STL" "$CELLS"
 "$PY" scripts/dropcutter-ocl.py drop "$STL" "$REGION" "$PICK" "$STEP" "$WORK/ocl.csv" > "$WORK/ocl-times.txt"
-echo '{"kind": "flat", "radius": 3}' > "$WORK/flat.json"
-echo '{"kind": "ball", "radius": 3}' > "$WORK/ball.json"
-echo '{"kind": "bull", "radius": 3, "corner_radius": 1}' > "$WORK/bull.json"
-echo '{"kind": "cone", "radius": 3, "half_angle": 34.37746770784939}' > "$WORK/cone.json"
 for C in flat ball bull cone; do
   "$BIN" "$STL" --tool "$WORK/$C.json" --region=$REGION --pick "$PICK" --max-step "$STEP" --threads 1 \
     -o "$WORK/ours-$C.csv" --report "$WORK/ours-$C.json"

@@ -16,20 +16,9 @@ MODEL=${MODEL:-data/step/block.step}
 PICK=${PICK:-4}
 STEP=${STEP:-2}
 DEFLECTION=${DEFLECTION:-0.0005}
-mkdir -p "$WORK"
-if [ ! -x "$WORK/venv/bin/python" ]; then
-  python3 -m venv "$WORK/venv"
-fi
-"$WORK/venv/bin/pip" install -q opencamlib
-cargo build -q --release -p stylus-trace
-BIN=${CARGO_TARGET_DIR:-target}/release/stylus-trace
-PY="$WORK/venv/bin/python"
+. scripts/ocl-env.sh
 STL="$WORK/$(basename "$MODEL" .step).stl"
 [ -s "$STL" ] || IN="$MODEL" OUT="$STL" DEFLECTION="$DEFLECTION" freecadcmd scripts/step-stl.py | tail -1
-echo '{"kind": "flat", "radius": 3}' > "$WORK/flat.json"
-echo '{"kind": "ball", "radius": 3}' > "$WORK/ball.json"
-echo '{"kind": "bull", "radius": 3, "corner_radius": 1}' > "$WORK/bull.json"
-echo '{"kind": "cone", "radius": 3, "half_angle": 34.37746770784939}' > "$WORK/cone.json"
 : > "$WORK/ocl-times.txt"
 for C in flat ball bull cone; do
   "$BIN" "$MODEL" --tool "$WORK/$C.json" --pick "$PICK" --max-step "$STEP" --threads 1 -q \

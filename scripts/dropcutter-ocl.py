@@ -60,24 +60,29 @@ def grid(region, pick, step):
     return [(x, y0 + k * pick) for k in range(n + 1) for x in stations(x0, x1, step)]
 
 
+def batch(ocl, surf, name, points):
+    """One cutter's BatchDropCutter over the points on one thread: its CL points and seconds."""
+    bdc = ocl.BatchDropCutter()
+    bdc.setSTL(surf)
+    cutter = CUTTERS[name](ocl)  # held here: setCutter keeps only a pointer to it
+    bdc.setCutter(cutter)
+    bdc.setThreads(1)
+    for x, y in points:
+        bdc.appendPoint(ocl.CLPoint(x, y, -100.0))
+    t0 = time.perf_counter()
+    bdc.run()
+    dt = time.perf_counter() - t0
+    return bdc.getCLPoints(), dt
+
+
 def drop(stl, region, pick, step, out):
     import opencamlib as ocl
     surf = ocl.STLSurf()
     ocl.STLReader(stl, surf)
     points = grid(region, pick, step)
     rows = []
-    for name, make in CUTTERS.items():
-        bdc = ocl.BatchDropCutter()
-        bdc.setSTL(surf)
-        cutter = make(ocl)  # held here: setCutter keeps only a pointer to it
-        bdc.setCutter(cutter)
-        bdc.setThreads(1)
-        for x, y in points:
-            bdc.appendPoint(ocl.CLPoint(x, y, -100.0))
-        t0 = time.perf_counter()
-        bdc.run()
-        dt = time.perf_counter() - t0
-        cl = bdc.getCLPoints()
+    for name in CUTTERS:
+        cl, dt = batch(ocl, surf, name, points)
         print(f"{name} {len(cl)} {dt:.6f}")
         rows += [(name, p.x, p.y, p.z) for p in cl]
     with open(out, "w") as f:
@@ -94,17 +99,7 @@ def drop_at(stl, name, points_csv, out):
     surf = ocl.STLSurf()
     ocl.STLReader(stl, surf)
     points = [(float(r["x"]), float(r["y"])) for r in csv.DictReader(open(points_csv))]
-    bdc = ocl.BatchDropCutter()
-    bdc.setSTL(surf)
-    cutter = CUTTERS[name](ocl)  # held here: setCutter keeps only a pointer to it
-    bdc.setCutter(cutter)
-    bdc.setThreads(1)
-    for x, y in points:
-        bdc.appendPoint(ocl.CLPoint(x, y, -100.0))
-    t0 = time.perf_counter()
-    bdc.run()
-    dt = time.perf_counter() - t0
-    cl = bdc.getCLPoints()
+    cl, dt = batch(ocl, surf, name, points)
     print(f"{name} {len(cl)} {dt:.6f}")
     with open(out, "w") as f:
         f.write("x,y,z\n")

@@ -68,6 +68,10 @@ fn angle(a: &V3, b: &V3) -> f64 {
     a.cross(b).norm().atan2(a.dot(b))
 }
 
+/// A concave cylinder R 100 along y, lowest along the line x = 0, z = 0.
+const CONCAVE_CYLINDER: &str =
+    r#"{"surfaces": [{"type": "cylinder", "point": [0, 0, 100], "axis": [0, 1, 0], "radius": 100, "flip": true}]}"#;
+
 const CYL: &str = r#"{"kind": "cylindrical-nonrotating", "radius": 12.5, "length": 40}"#;
 
 #[test]
@@ -118,10 +122,7 @@ fn rear_gouge_in_a_concave_region_takes_the_closed_form_tilt() {
     // Trough of radius ρ = 100: the tilted bottom face's rear rim point clears iff sin|θ| ≥ R/ρ.
     let w = Work::new();
     let rho = 100.0;
-    w.write(
-        "m.json",
-        r#"{"surfaces": [{"type": "cylinder", "point": [0, 0, 100], "axis": [0, 1, 0], "radius": 100, "flip": true}]}"#,
-    );
+    w.write("m.json", CONCAVE_CYLINDER);
     let contacts = circle(P3::new(0.0, 0.0, rho), (V3::x(), V3::z()), rho, (-1.7, 0.01, 10), true);
     w.write("cl.csv", stream(&contacts, 12.5));
     w.write("tool.json", CYL);
@@ -362,10 +363,7 @@ fn bad_input_is_refused_with_its_place() {
 #[test]
 fn output_is_the_same_for_any_thread_count() {
     let w = Work::new();
-    w.write(
-        "m.json",
-        r#"{"surfaces": [{"type": "cylinder", "point": [0, 0, 100], "axis": [0, 1, 0], "radius": 100, "flip": true}]}"#,
-    );
+    w.write("m.json", CONCAVE_CYLINDER);
     let contacts = circle(P3::new(0.0, 0.0, 100.0), (V3::x(), V3::z()), 100.0, (-1.7, 0.01, 40), true);
     w.write("cl.csv", stream(&contacts, 12.5));
     w.write("tool.json", CYL);
@@ -659,10 +657,7 @@ fn fixed_axis_streams_across_chunks() {
 #[test]
 fn tilt_modes_stream_pass_by_pass() {
     let w = Work::new();
-    w.write(
-        "m.json",
-        r#"{"surfaces": [{"type": "cylinder", "point": [0, 0, 100], "axis": [0, 1, 0], "radius": 100, "flip": true}]}"#,
-    );
+    w.write("m.json", CONCAVE_CYLINDER);
     w.write("tool.json", CYL);
     let mut cl = String::from("path,x,y,z,px,py,pz,nx,ny,nz\n");
     for pass in 0..30 {
