@@ -225,6 +225,9 @@ fn verified_from(
             // A loop no longer than the tolerance is round-off where two loops touch (the lens
             // between two tangent circles): the tool would cut nothing there.
             out.retain(|c| longer_than(c, opts.tol));
+            if closed {
+                out.retain(|c| !is_sliver(c, opts.tol));
+            }
             match verify(set, &out, d, side, closed, opts.tol, opts.self_crossing_input, scope) {
                 Ok(check) => return Ok(Offset { contours: out, check, attempts, cleaned: was_cleaned }),
                 Err(e) => defect = Some(e),
@@ -233,6 +236,19 @@ fn verified_from(
     }
     Err(OffsetError { attempts, defect: defect.expect("at least one attempt") })
 }
+
+/// True if `c`, a piece of the offset of closed contours, is open and no longer than
+/// [`SLIVER_TOLS`] tolerances `tol`: a sliver of a swallowtail at a bend within a hair of the
+/// offset distance, whose points lie less than the kernel's distance epsilon inside it (which
+/// passes them) but which closes on nothing (the `--wiggle` fuzz, seed 93: 1.9 and 9.4 µm long
+/// beside the loop that verifies; joined end to end it crossed that loop). Such pieces are
+/// dropped; had one been offset, the completeness check would find the gap.
+fn is_sliver(c: &Contour, tol: f64) -> bool {
+    !c.closed && !longer_than(c, SLIVER_TOLS * tol)
+}
+
+/// Longest open piece of a closed offset dropped as a sliver, in tolerances ([`is_sliver`]).
+const SLIVER_TOLS: f64 = 1000.0;
 
 /// Offset distances tried, as fractions of the tolerance added to the asked one: first exact;
 /// then, if no run verifies, just inside and just outside it. Walls exactly 2d apart offset by d
@@ -281,10 +297,11 @@ pub fn offset_contour(c: &Contour, d: f64, side: Side, opts: &OffsetOptions) -> 
     let closed = c.closed && !(opts.self_crossing_input && c.self_crossing().is_some());
     verified(&[c], d, side.sign(), closed, opts, |source, nudge, (pos, dist), index| {
         let k = kernel_scale(source);
-        let pline: Polyline<f64> = scaled(source[0], k).to_pline();
+        let eased = without_flat_joints(source[0], d, opts.tol);
+        let pline: Polyline<f64> = scaled(eased.as_ref().unwrap_or(source[0]), k).to_pline();
         let o = PlineOffsetOptions {
-            // The verification's index holds the pieces unscaled.
-            aabb_index: index.filter(|_| k == 1.0),
+            // The verification's index holds the pieces unscaled and uneased.
+            aabb_index: index.filter(|_| k == 1.0 && eased.is_none()),
             handle_self_intersects: opts.self_crossing_input,
             pos_equal_eps: pos * k,
             offset_dist_eps: dist * k,
@@ -293,9 +310,56 @@ pub fn offset_contour(c: &Contour, d: f64, side: Side, opts: &OffsetOptions) -> 
         };
         let out = pline.parallel_offset_opt((d + nudge) * side.sign() * k, &o);
         let gap = if closed { KERNEL_PIECE / k } else { 0.0 };
-        out.iter().map(|p| closed_across(scaled(&Contour::from_pline(p), 1.0 / k), gap)).collect()
+        out.iter()
+            .map(|p| scaled(&Contour::from_pline(p), 1.0 / k))
+            .filter(|c| !(closed && is_sliver(c, opts.tol)))
+            .map(|c| closed_across(c, gap))
+            .collect()
     })
 }
+
+/// `c` without the vertices between two lines that turn by less than the kernel can trim
+/// reliably at offset `d` (mm), each vertex dropped only while the lines it joined stay within
+/// `tol / 16` (mm) of the line that replaces them; `None` if none is dropped. cavalier_contours
+/// trims two offset lines at their crossing, computed with a round-off along the lines of about
+/// ε·|p| / θ (ε the machine epsilon, |p| the coordinates' size, θ the turn), while the true crossing
+/// lies only d·θ / 2 inside the next line: below θ ≈ √(2ε|p|/d) round-off can put it outside, the
+/// join is taken as a gap, and the whole slice of the offset around it is dropped (issue 20, D13:
+/// the `--wiggle` fuzz, seed 93, an inflection of a 58 650-line wiggle where θ = 2.2e-8 rad, its
+/// crossing computed 1.4e-7 mm outside the line: 25 mm of the offset lost). The result is
+/// verified against the contour as given.
+fn without_flat_joints(c: &Contour, d: f64, tol: f64) -> Option<Contour> {
+    let n = c.vertices.len();
+    let size = c.vertices.iter().fold(1.0f64, |m, v| m.max(v.p.coords.abs().max()));
+    let min_turn = FLAT_TURN_SAFETY * (f64::EPSILON * size / d).sqrt();
+    let max_dev = tol / 16.0;
+    let last = if c.closed { n } else { n.saturating_sub(1) };
+    let mut kept: Vec<super::Vertex> = Vec::with_capacity(n);
+    let mut run: Vec<P2> = Vec::new();
+    for (i, v) in c.vertices.iter().enumerate() {
+        let Some(a) = kept.last().filter(|a| a.bulge == 0.0 && v.bulge == 0.0 && i < last) else {
+            kept.push(*v);
+            run.clear();
+            continue;
+        };
+        let next = c.vertices[(i + 1) % n].p;
+        let (u, w) = (v.p - a.p, next - v.p);
+        let turn = crate::geom::cross2(&u, &w).atan2(u.dot(&w)).abs();
+        let chord = next - a.p;
+        let len = chord.norm();
+        let near = |p: &P2| len > 0.0 && (crate::geom::cross2(&chord, &(p - a.p)) / len).abs() <= max_dev;
+        if turn < min_turn && near(&v.p) && run.iter().all(near) {
+            run.push(v.p);
+        } else {
+            kept.push(*v);
+            run.clear();
+        }
+    }
+    (kept.len() < n).then_some(Contour { vertices: kept, closed: c.closed })
+}
+
+/// Margin of [`without_flat_joints`]' smallest reliable turn over its estimate.
+const FLAT_TURN_SAFETY: f64 = 4.0;
 
 /// `c` closed if it is open with its ends less than `gap` (mm) apart: cut back to where its
 /// first and last few lines cross, or else joined by a line. Where a bend is within a fraction
@@ -380,7 +444,7 @@ pub fn offset_region(region: &Region, d: f64, opts: &OffsetOptions) -> Result<Of
 pub fn grow_region(loops: &[&Contour], d: f64, opts: &OffsetOptions) -> Result<Offset, OffsetError> {
     let set = SegSet::new(loops.iter().copied());
     verified_from(&set, loops, loops, d, -1.0, true, opts, false, &[], |source, nudge, eps, _| {
-        shape_offset(source, -(d + nudge), eps)
+        shape_offset(source, -(d + nudge), eps, opts.tol)
     })
 }
 
@@ -421,7 +485,7 @@ pub(crate) fn offset_region_in(
 ) -> Result<Offset, OffsetError> {
     let loops = region.loops();
     verified_from(&pieces.0, &loops, &loops, d, 1.0, true, opts, true, &[], |source, nudge, eps, _| {
-        shape_offset(source, d + nudge, eps)
+        shape_offset(source, d + nudge, eps, opts.tol)
     })
 }
 
@@ -438,7 +502,7 @@ pub(crate) fn offset_region_further(
     opts: &OffsetOptions,
 ) -> Result<Offset, OffsetError> {
     verified_from(&pieces.0, loops, &region.loops(), total, 1.0, true, opts, false, loops, |source, nudge, eps, _| {
-        shape_offset(source, rel + nudge, eps)
+        shape_offset(source, rel + nudge, eps, opts.tol)
     })
 }
 
@@ -460,14 +524,21 @@ pub fn check_offset(
 /// `d`, by one unverified kernel run at the input's own epsilons (a probe, not a result).
 pub fn region_survives(loops: &[&Contour], d: f64) -> bool {
     // A run stopped by the kernel's own checks (see [`guarded`]) is retried with the next epsilons.
-    ladder(loops).into_iter().find_map(|eps| guarded(|| shape_offset(loops, d, eps))).is_some_and(|o| !o.is_empty())
+    ladder(loops)
+        .into_iter()
+        .find_map(|eps| guarded(|| shape_offset(loops, d, eps, tol::OFFSET_TOL)))
+        .is_some_and(|o| !o.is_empty())
 }
 
 /// One run of cavalier's shape offset on loops oriented as a region (outer counter-clockwise,
-/// islands clockwise), scaled as [`kernel_scale`] says.
-pub(crate) fn shape_offset(loops: &[&Contour], d: f64, (pos, dist): Eps) -> Vec<Contour> {
+/// islands clockwise), scaled as [`kernel_scale`] says, each loop eased as [`without_flat_joints`]
+/// says for the tolerance `tol` (mm).
+pub(crate) fn shape_offset(loops: &[&Contour], d: f64, (pos, dist): Eps, tol: f64) -> Vec<Contour> {
     let k = kernel_scale(loops);
-    let shape = Shape::from_plines(loops.iter().map(|c| scaled(c, k).to_pline()));
+    let shape = Shape::from_plines(loops.iter().map(|&c| {
+        let eased = without_flat_joints(c, d.abs(), tol);
+        scaled(eased.as_ref().unwrap_or(c), k).to_pline()
+    }));
     let (pos, dist) = (pos * k, dist * k);
     let o = ShapeOffsetOptions { pos_equal_eps: pos, offset_dist_eps: dist, slice_join_eps: dist.max(pos) };
     let out = shape.parallel_offset(d * k, &o);
@@ -758,12 +829,59 @@ mod tests {
         assert!(check_offset(&[&c], &o.contours, r, Side::Left, true, opts.tol).is_ok());
     }
 
-    /// A case of D13's class still failing ("offset loop is open"), found by the proptest below
-    /// under the project's seed (PROPTEST_RNG_SEED=20261122, its minimal input): kept ignored until the class is
-    /// closed; run it with `--ignored`.
+    /// The `--wiggle` fuzz's seed 93 (issue 20, D13): r = 50 + a sin(6t + p) + b sin(112t + q)
+    /// drawn with 58 650 lines (5-10 µm), offset outward by 0.5. At an inflection two lines turn
+    /// by 2.2e-8 rad; the kernel computed their offsets' crossing 1.4e-7 mm outside the next line,
+    /// took the join as a gap and dropped 25 mm of the loop, at every epsilon; beside it slivers of
+    /// swallowtails (1.9 and 9.4 µm, open) were left. Eased ([`without_flat_joints`]: 10 vertices
+    /// dropped, each within tol / 16 of the line that replaced it) and the slivers dropped
+    /// ([`is_sliver`]), the first run verifies as one loop.
     #[test]
-    #[ignore = "D13's class is still open: this dense bend 1.08 % under R fails"]
-    fn dense_bend_just_under_r_still_fails() {
+    fn a_wiggle_with_flat_inflections_offsets_whole() {
+        let (n, a, p, q, b) = (58_650, 4.337730930147837, 5.563746035961687, 0.5783947738922712, 0.45839341530228594);
+        let round = |v: f64| (v * 1e9).round() / 1e9;
+        let pts: Vec<P2> = (0..n)
+            .map(|i| 2.0 * PI * f64::from(i) / f64::from(n))
+            .map(|t| {
+                let r = 50.0 + a * (6.0 * t + p).sin() + b * (112.0 * t + q).sin();
+                P2::new(round(r * t.cos()), round(r * t.sin()))
+            })
+            .collect();
+        let c = Contour::polygon(&pts, true);
+        let opts = OffsetOptions::default();
+        let o = offset_contour(&c, 0.5, Side::Right, &opts).unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!((o.contours.len(), o.contours[0].closed, o.attempts), (1, true, 1));
+        assert!(o.check.deviation() <= opts.tol, "{:?}", o.check);
+        // Every vertex the easing dropped lies within tol / 16 of the line between the vertices
+        // kept either side of it (the kept ones are the contour's, in order).
+        let eased = without_flat_joints(&c, 0.5, opts.tol).expect("flat joints at the inflections");
+        assert!((1..=100).contains(&(n as usize - eased.vertices.len())), "{}", eased.vertices.len());
+        let off_chord = |a: P2, b: P2, v: &P2| (crate::geom::cross2(&(b - a), &(v - a)) / (b - a).norm()).abs();
+        let mut next = 0;
+        for (j, k) in eased.vertices.iter().enumerate() {
+            let at = pts.iter().skip(next).position(|p| *p == k.p).expect("kept in order") + next;
+            if j > 0 {
+                assert!(pts[next..at].iter().all(|v| off_chord(eased.vertices[j - 1].p, k.p, v) <= opts.tol / 16.0));
+            }
+            next = at + 1;
+        }
+        let (last, first) = (eased.vertices[eased.vertices.len() - 1].p, eased.vertices[0].p);
+        assert!(pts[next..].iter().all(|v| off_chord(last, first, v) <= opts.tol / 16.0));
+        // A contour with no flat joint (a 100-gon) is left as it is.
+        let gon: Vec<P2> = (0..100).map(|k| 0.0628 * f64::from(k)).map(|t| P2::new(t.cos(), t.sin())).collect();
+        assert!(without_flat_joints(&Contour::polygon(&gon, true), 0.5, opts.tol).is_none());
+    }
+
+    /// A case of D13's class that still fails, found by the proptest below under the project's
+    /// seed before the fixes of 2026-11-27 (PROPTEST_RNG_SEED=20261122, its minimal input): 143 118
+    /// lines for the turn, of which the 229 kept here (2.3 µm each) lie within 3e-6 mm of a circle
+    /// of radius R about one point, so that all their offsets pass within microns of it. At every
+    /// epsilon the kernel loses the loop in that fan (Missing), or returns it open across the fan,
+    /// and closed at the crossing of its end lines it gouges by 1.3e-6 mm (tolerance 1e-6). The
+    /// proptest itself passes under that seed since. Run it with `--ignored`.
+    #[test]
+    #[ignore = "a bend equal to R within 2e-5 of it: the kernel's loop is lost in the fan"]
+    fn a_bend_equal_to_r_within_2e5_still_fails() {
         let b = (50.0f64 / 52.0).powi(2) / 1.0363722763992762;
         let (c, rho) = wiggle_bend(143_118, (2.4883864625834424, 3.0), (b, 52.0), 19, true, 0.005053368796153272);
         let r = rho * (1.0 - 0.010755669223625409);
@@ -779,10 +897,7 @@ mod tests {
         /// a radius within 4 % of their tightest bend either way, where the offset's swallowtail
         /// is microns across; a stretch of 50-4 000 lines round one bend, closed by a box, bent
         /// both ways (crest offset inward, trough outward). Every run verifies as one loop.
-        /// Ignored: the class is not closed — the project's seed and random ones find failures
-        /// (one is the ignored test above); run it with `--ignored`.
         #[test]
-        #[ignore = "D13's class is still open (see the comment)"]
         fn dense_smooth_bends_near_r_offset_whole(
             n in 10_000usize..400_000,
             m in 3u32..9,
