@@ -3,7 +3,7 @@
 must give a verified result (exit 0) or refuse the input naming a crossing (exit 2). Anything
 else (exit 1: no verified offset; a crash) is a defect and its input is kept.
 
-  scripts/fuzz-offset.py [SEEDS] [--spiky | --fine | --fillets | --far | --tiny | --open | --wiggle]
+  scripts/fuzz-offset.py [SEEDS [FIRST]] [--spiky | --fine | --fillets | --far | --tiny | --open | --wiggle]
                                              (offset binary: $OFFSET or target/release/offset)
 
 --spiky widens radii and bulges so that many stars fold across themselves (refusals expected).
@@ -154,6 +154,7 @@ def star(seed, family):
 def main():
     args = [a for a in sys.argv[1:] if not a.startswith("--")]
     seeds = int(args[0]) if args else 100
+    first = int(args[1]) if len(args) > 1 else 1
     families = [f for f in ("spiky", "fine", "fillets", "far", "tiny", "open", "wiggle") if f"--{f}" in sys.argv]
     family = families[0] if families else "smooth"
     k = 0.01 if family == "tiny" else 1
@@ -171,7 +172,7 @@ def main():
     counts, kept = {"ok": 0, "refused": 0, "defect": 0}, []
     with tempfile.TemporaryDirectory() as tmp:
         src, out = os.path.join(tmp, "star.csv"), os.path.join(tmp, "out.csv")
-        for seed in range(1, seeds + 1):
+        for seed in range(first, first + seeds):
             with open(src, "w") as f:
                 f.write(walk(seed) if family == "open" else wiggle(seed) if family == "wiggle" else star(seed, family))
             for run in runs:

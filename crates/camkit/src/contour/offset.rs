@@ -225,6 +225,9 @@ fn verified_from(
             // A loop no longer than the tolerance is round-off where two loops touch (the lens
             // between two tangent circles): the tool would cut nothing there.
             out.retain(|c| longer_than(c, opts.tol));
+            if closed {
+                out.retain(|c| !is_sliver(c, opts.tol));
+            }
             match verify(set, &out, d, side, closed, opts.tol, opts.self_crossing_input, scope) {
                 Ok(check) => return Ok(Offset { contours: out, check, attempts, cleaned: was_cleaned }),
                 Err(e) => defect = Some(e),
@@ -233,6 +236,19 @@ fn verified_from(
     }
     Err(OffsetError { attempts, defect: defect.expect("at least one attempt") })
 }
+
+/// True if `c`, a piece of the offset of closed contours, is open and no longer than
+/// [`SLIVER_TOLS`] tolerances `tol`: a sliver of a swallowtail at a bend within a hair of the
+/// offset distance, whose points lie less than the kernel's distance epsilon inside it (which
+/// passes them) but which closes on nothing (the `--wiggle` fuzz, seed 93: 1.9 and 9.4 µm long
+/// beside the loop that verifies; joined end to end it crossed that loop). Such pieces are
+/// dropped; had one been offset, the completeness check would find the gap.
+fn is_sliver(c: &Contour, tol: f64) -> bool {
+    !c.closed && !longer_than(c, SLIVER_TOLS * tol)
+}
+
+/// Longest open piece of a closed offset dropped as a sliver, in tolerances ([`is_sliver`]).
+const SLIVER_TOLS: f64 = 1000.0;
 
 /// Offset distances tried, as fractions of the tolerance added to the asked one: first exact;
 /// then, if no run verifies, just inside and just outside it. Walls exactly 2d apart offset by d
@@ -279,22 +295,39 @@ pub fn offset_contour(c: &Contour, d: f64, side: Side, opts: &OffsetOptions) -> 
     // A closed contour that crosses itself has no side that stays inside: its offset is what the
     // tool can cut on that side, loops and open stretches ending where they would gouge.
     let closed = c.closed && !(opts.self_crossing_input && c.self_crossing().is_some());
-    verified(&[c], d, side.sign(), closed, opts, |source, nudge, (pos, dist), index| {
-        let k = kernel_scale(source);
-        let pline: Polyline<f64> = scaled(source[0], k).to_pline();
-        let o = PlineOffsetOptions {
-            // The verification's index holds the pieces unscaled.
-            aabb_index: index.filter(|_| k == 1.0),
-            handle_self_intersects: opts.self_crossing_input,
-            pos_equal_eps: pos * k,
-            offset_dist_eps: dist * k,
-            touching_loop_behavior: TouchingLoopBehavior::Separate,
-            ..Default::default()
-        };
-        let out = pline.parallel_offset_opt((d + nudge) * side.sign() * k, &o);
-        let gap = if closed { KERNEL_PIECE / k } else { 0.0 };
-        out.iter().map(|p| closed_across(scaled(&Contour::from_pline(p), 1.0 / k), gap)).collect()
+    verified(&[c], d, side.sign(), closed, opts, |source, nudge, eps, index| {
+        contour_kernel(source[0], (d + nudge) * side.sign(), closed, eps, index, opts)
     })
+}
+
+/// One kernel run of [`offset_contour`] on `c` by `d` (mm, left positive), its result closed
+/// where `closed` asks for loops; `index` is the verification's index of `c`'s pieces, if any.
+fn contour_kernel(
+    c: &Contour,
+    d: f64,
+    closed: bool,
+    (pos, dist): Eps,
+    index: Option<&Index>,
+    opts: &OffsetOptions,
+) -> Vec<Contour> {
+    let k = kernel_scale(&[c]);
+    let pline: Polyline<f64> = scaled(c, k).to_pline();
+    let o = PlineOffsetOptions {
+        // The verification's index holds the pieces unscaled.
+        aabb_index: index.filter(|_| k == 1.0),
+        handle_self_intersects: opts.self_crossing_input,
+        pos_equal_eps: pos * k,
+        offset_dist_eps: dist * k,
+        touching_loop_behavior: TouchingLoopBehavior::Separate,
+        ..Default::default()
+    };
+    let out = pline.parallel_offset_opt(d * k, &o);
+    let gap = if closed { KERNEL_PIECE / k } else { 0.0 };
+    out.iter()
+        .map(|p| scaled(&Contour::from_pline(p), 1.0 / k))
+        .filter(|c| !(closed && is_sliver(c, opts.tol)))
+        .map(|c| closed_across(c, gap))
+        .collect()
 }
 
 /// `c` closed if it is open with its ends less than `gap` (mm) apart: cut back to where its
@@ -420,9 +453,38 @@ pub(crate) fn offset_region_in(
     opts: &OffsetOptions,
 ) -> Result<Offset, OffsetError> {
     let loops = region.loops();
-    verified_from(&pieces.0, &loops, &loops, d, 1.0, true, opts, true, &[], |source, nudge, eps, _| {
+    let shape = verified_from(&pieces.0, &loops, &loops, d, 1.0, true, opts, true, &[], |source, nudge, eps, _| {
         shape_offset(source, d + nudge, eps)
+    });
+    one_loop_fallback(shape, &pieces.0, &loops, &loops, (d, d), opts, &[])
+}
+
+/// `shape`, a region offset of `source` by `kernel_d` (mm) verified against `input` (its pieces
+/// in `set`) at `d`; or, if no shape run verified and `source` is one loop (counter-clockwise, as
+/// a region's only loop is), the same offset by the contour kernel ([`contour_kernel`]: inward is
+/// left of it), verified alike within `scope`. A second route through cavalier_contours that
+/// leaves out the shape offset's stitching of slices across loops (the `--wiggle` fuzz, seed 128:
+/// every shape run of the pocket's first level gouged by 0.19 mm or lost pieces; the contour
+/// kernel's verified). The kernel runs of both are counted; results the shape offset verifies
+/// are as before.
+fn one_loop_fallback(
+    shape: Result<Offset, OffsetError>,
+    set: &SegSet,
+    source: &[&Contour],
+    input: &[&Contour],
+    (d, kernel_d): (f64, f64),
+    opts: &OffsetOptions,
+    scope: &[&Contour],
+) -> Result<Offset, OffsetError> {
+    let Err(e) = shape else { return shape };
+    if source.len() != 1 {
+        return Err(e);
+    }
+    verified_from(set, source, input, d, 1.0, true, opts, false, scope, |src, nudge, eps, index| {
+        contour_kernel(src[0], kernel_d + nudge, true, eps, index, opts)
     })
+    .map(|o| Offset { attempts: e.attempts + o.attempts, ..o })
+    .map_err(|f| OffsetError { attempts: e.attempts + f.attempts, defect: e.defect })
 }
 
 /// Offsets `loops` (a region already offset from `region`'s loops, oriented as a region) inward
@@ -437,9 +499,12 @@ pub(crate) fn offset_region_further(
     total: f64,
     opts: &OffsetOptions,
 ) -> Result<Offset, OffsetError> {
-    verified_from(&pieces.0, loops, &region.loops(), total, 1.0, true, opts, false, loops, |source, nudge, eps, _| {
-        shape_offset(source, rel + nudge, eps)
-    })
+    let input = region.loops();
+    let shape =
+        verified_from(&pieces.0, loops, &input, total, 1.0, true, opts, false, loops, |source, nudge, eps, _| {
+            shape_offset(source, rel + nudge, eps)
+        });
+    one_loop_fallback(shape, &pieces.0, loops, &input, (total, rel), opts, loops)
 }
 
 /// Verifies offsets made elsewhere (another kernel, another run) by the check every result of
@@ -517,6 +582,27 @@ mod tests {
         assert_eq!(g.contours.len(), 2);
         let island = g.contours.iter().find(|c| !c.is_ccw()).expect("the island");
         assert!((island.area().abs() - PI).abs() < 1e-9);
+    }
+
+    /// A region offset no shape run verified is tried again by the contour kernel when the
+    /// region is one loop (a 10 × 10 square shrunk by 2: the 6 × 6 square, one more run), not
+    /// when it has an island; the runs of both routes are counted.
+    #[test]
+    fn a_one_loop_region_the_shape_runs_missed_is_offset_by_the_contour_kernel() {
+        let opts = OffsetOptions::default();
+        let failed = || Err(OffsetError { attempts: 36, defect: Defect::Kernel });
+        let square =
+            Contour::polygon(&[P2::new(0.0, 0.0), P2::new(10.0, 0.0), P2::new(10.0, 10.0), P2::new(0.0, 10.0)], true);
+        let (rs, _) = crate::contour::region::regions(std::slice::from_ref(&square)).unwrap();
+        let (pieces, loops) = (RegionPieces::new(&rs[0]), rs[0].loops());
+        let o = one_loop_fallback(failed(), &pieces.0, &loops, &loops, (2.0, 2.0), &opts, &[]).unwrap();
+        assert_eq!((o.attempts, o.contours.len()), (37, 1));
+        assert!((o.contours[0].area() - 36.0).abs() < 1e-9, "{}", o.contours[0].area());
+        let island = Contour::circle(P2::new(5.0, 5.0), 1.0, 0.0, false);
+        let (rs, _) = crate::contour::region::regions(&[square, island]).unwrap();
+        let (pieces, loops) = (RegionPieces::new(&rs[0]), rs[0].loops());
+        let e = one_loop_fallback(failed(), &pieces.0, &loops, &loops, (2.0, 2.0), &opts, &[]).unwrap_err();
+        assert_eq!((e.attempts, e.defect), (36, Defect::Kernel));
     }
 
     #[test]
@@ -758,12 +844,57 @@ mod tests {
         assert!(check_offset(&[&c], &o.contours, r, Side::Left, true, opts.tol).is_ok());
     }
 
-    /// A case of D13's class still failing ("offset loop is open"), found by the proptest below
-    /// under the project's seed (PROPTEST_RNG_SEED=20261122, its minimal input): kept ignored until the class is
-    /// closed; run it with `--ignored`.
+    /// The `--wiggle` fuzz's seed 93 (issue 20, D13): r = 50 + a sin(6t + p) + b sin(112t + q)
+    /// drawn with 58 650 lines (5-10 µm), offset outward by 0.5. At the first epsilons the kernel
+    /// left slivers of swallowtails (1.9 and 9.4 µm, open) beside a loop that verifies; joined
+    /// end to end they crossed it, left open they failed the check, at every run. Dropped
+    /// ([`is_sliver`]), the first run verifies.
     #[test]
-    #[ignore = "D13's class is still open: this dense bend 1.08 % under R fails"]
-    fn dense_bend_just_under_r_still_fails() {
+    fn a_wiggle_with_swallowtail_slivers_offsets_whole() {
+        let (n, a, p, q, b) = (58_650, 4.337730930147837, 5.563746035961687, 0.5783947738922712, 0.45839341530228594);
+        let round = |v: f64| (v * 1e9).round() / 1e9;
+        let pts: Vec<P2> = (0..n)
+            .map(|i| 2.0 * PI * f64::from(i) / f64::from(n))
+            .map(|t| {
+                let r = 50.0 + a * (6.0 * t + p).sin() + b * (112.0 * t + q).sin();
+                P2::new(round(r * t.cos()), round(r * t.sin()))
+            })
+            .collect();
+        let c = Contour::polygon(&pts, true);
+        let opts = OffsetOptions::default();
+        let o = offset_contour(&c, 0.5, Side::Right, &opts).unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!((o.contours.len(), o.contours[0].closed, o.attempts), (1, true, 1));
+        assert!(o.check.deviation() <= opts.tol, "{:?}", o.check);
+        // The same first run with the slivers kept: open pieces no longer than 1000 tolerances.
+        let (set, ladder) = (SegSet::new([&c]), ladder(&[&c]));
+        let k = kernel_scale(&[&c]);
+        let options = PlineOffsetOptions {
+            pos_equal_eps: ladder[0].0 * k,
+            offset_dist_eps: ladder[0].1 * k,
+            touching_loop_behavior: TouchingLoopBehavior::Separate,
+            ..Default::default()
+        };
+        let raw: Vec<Contour> = scaled(&c, k)
+            .to_pline()
+            .parallel_offset_opt(-0.5 * k, &options)
+            .iter()
+            .map(|p| scaled(&Contour::from_pline(p), 1.0 / k))
+            .collect();
+        let slivers = raw.iter().filter(|l| is_sliver(l, opts.tol)).count();
+        assert!(slivers >= 1 && raw.iter().any(|l| l.closed), "{slivers} slivers of {}", raw.len());
+        assert!(verify(&set, &raw, 0.5, -1.0, true, opts.tol, false, &[]).is_err());
+    }
+
+    /// A case of D13's class that still fails, found by the proptest below under the project's
+    /// seed before the fixes of 2026-11-27 (PROPTEST_RNG_SEED=20261122, its minimal input): 143 118
+    /// lines for the turn, of which the 229 kept here (2.3 µm each) lie within 3e-6 mm of a circle
+    /// of radius R about one point, so that all their offsets pass within microns of it. At every
+    /// epsilon the kernel loses the loop in that fan (Missing), or returns it open across the fan,
+    /// and closed at the crossing of its end lines it gouges by 1.3e-6 mm (tolerance 1e-6). The
+    /// proptest itself passes under that seed since. Run it with `--ignored`.
+    #[test]
+    #[ignore = "a bend equal to R within 2e-5 of it: the kernel's loop is lost in the fan"]
+    fn a_bend_equal_to_r_within_2e5_still_fails() {
         let b = (50.0f64 / 52.0).powi(2) / 1.0363722763992762;
         let (c, rho) = wiggle_bend(143_118, (2.4883864625834424, 3.0), (b, 52.0), 19, true, 0.005053368796153272);
         let r = rho * (1.0 - 0.010755669223625409);
@@ -779,10 +910,7 @@ mod tests {
         /// a radius within 4 % of their tightest bend either way, where the offset's swallowtail
         /// is microns across; a stretch of 50-4 000 lines round one bend, closed by a box, bent
         /// both ways (crest offset inward, trough outward). Every run verifies as one loop.
-        /// Ignored: the class is not closed — the project's seed and random ones find failures
-        /// (one is the ignored test above); run it with `--ignored`.
         #[test]
-        #[ignore = "D13's class is still open (see the comment)"]
         fn dense_smooth_bends_near_r_offset_whole(
             n in 10_000usize..400_000,
             m in 3u32..9,
