@@ -4,7 +4,8 @@
 //! with one line (exit 2) or, with --skip-unsupported, the face left out with a warning.
 
 use camkit::geom::{P3, V3};
-use e2e::{Work, data};
+use camkit::num::golden_arg;
+use e2e::{Outcome, Work, data};
 
 const BIN: &str = "stylus-trace";
 
@@ -196,14 +197,7 @@ fn tool_attitude_gouge_checks_against_step_faces() {
     // Contacts to 1 nm, so that what the check reads is the triangles' chord alone.
     let trace = [&m, "-r", "3", "--pick", "5", "--region=30,70,30,70", "--contact-tol", "1e-6", "-q", "-o", "cl.csv"];
     w.run(BIN, &trace, b"").ok();
-    w.write("ball.json", r#"{"kind": "ball", "radius": 3}"#);
-    let args =
-        |input: &'static str| vec![input, "--tool", "ball.json", "--model", &m, "-o", "t.csv", "--report", "r.json"];
-    w.run("tool-attitude", &args("cl.csv"), b"").ok();
-    let r: serde_json::Value = serde_json::from_str(&w.read("r.json")).unwrap();
-    let chord = r["gouge_chord_mm"].as_f64().unwrap();
-    assert!(chord > 0.0 && chord <= 0.25e-3, "{r}");
-    assert_eq!(r["gouge_rows"], 0, "{r}");
+    let (r, chord) = clear_ball_check(&w, &m);
     // The faces' outlines run through points of their edges within the chord (no longer the
     // loops' polygons, arcs every π/256, whose sagitta at the dish's rim, R26.5, was 0.5 µm): the
     // balls grazing the rim read no more than the chord.
@@ -213,7 +207,7 @@ fn tool_attitude_gouge_checks_against_step_faces() {
     let rows = table(&cl);
     let k = rows.len() / 2;
     let nz = num(&rows[k], "nz");
-    let deepest = lowered_gouge(&w, &cl, k, &args("low.csv"));
+    let deepest = lowered_gouge(&w, &cl, k, &m);
     assert!((deepest - 0.1 * nz).abs() <= chord + 1e-6, "deepest {deepest} vs {}", 0.1 * nz);
 }
 
@@ -275,12 +269,8 @@ fn to_knob_profile(r: f64, z: f64) -> f64 {
     };
     let k: usize = 20_000;
     let i = (0..=k).min_by(|a, b| d(*a as f64 / k as f64).total_cmp(&d(*b as f64 / k as f64))).unwrap();
-    let (mut a, mut b) = (i.saturating_sub(1) as f64 / k as f64, ((i + 1).min(k)) as f64 / k as f64);
-    for _ in 0..80 {
-        let (c, e) = (b - (b - a) * 0.618, a + (b - a) * 0.618);
-        if d(c) < d(e) { b = e } else { a = c }
-    }
-    d(0.5 * (a + b))
+    let (a, b) = (i.saturating_sub(1) as f64 / k as f64, ((i + 1).min(k)) as f64 / k as f64);
+    d(golden_arg(|t| -d(t), a, b, 80))
 }
 
 /// The knob of revolve.step (two SURFACE_OF_REVOLUTION faces between two discs) traced whole:
@@ -348,20 +338,13 @@ fn tool_attitude_gouge_checks_surfaces_of_revolution() {
     let w = Work::new();
     let m = data("step/revolve.step").display().to_string();
     w.run(BIN, &[&m, "-r", "3", "--pick", "6", "--region=0,34,-34,34", "-q", "-o", "cl.csv"], b"").ok();
-    w.write("ball.json", r#"{"kind": "ball", "radius": 3}"#);
-    let args =
-        |input: &'static str| vec![input, "--tool", "ball.json", "--model", &m, "-o", "t.csv", "--report", "r.json"];
-    w.run("tool-attitude", &args("cl.csv"), b"").ok();
-    let r: serde_json::Value = serde_json::from_str(&w.read("r.json")).unwrap();
-    let chord = r["gouge_chord_mm"].as_f64().unwrap();
-    assert!(chord > 0.0 && chord <= 0.25e-3, "{r}");
-    assert_eq!(r["gouge_rows"], 0, "{r}");
+    let (_, chord) = clear_ball_check(&w, &m);
     let cl = w.read("cl.csv");
     let rows = table(&cl);
     // A row on the cubic face, 0.1 mm lower.
     let k = rows.iter().position(|r| text(r, "surface").starts_with("revolution") && num(r, "pz") < 14.0).unwrap();
     let nz = num(&rows[k], "nz");
-    let deepest = lowered_gouge(&w, &cl, k, &args("low.csv"));
+    let deepest = lowered_gouge(&w, &cl, k, &m);
     // The ball's depth in the curved face: its radius less the lowered centre's distance from
     // the swept cubic (the profile written out here); about 0.1 n_z.
     let c = p3(&rows[k], "x", "y", "z") - V3::z() * 0.1;
@@ -423,9 +406,26 @@ fn fixed_axis_cutters_on_surfaces_of_revolution() {
     }
 }
 
-/// tool-attitude run with `args` (its input low.csv) on the table `cl` with row `k`'s tip and
+/// tool-attitude's gouge check of a ball R3 on `input` against the model `m`.
+fn ball_check(w: &Work, input: &str, m: &str) -> Outcome {
+    w.write("ball.json", r#"{"kind": "ball", "radius": 3}"#);
+    w.run("tool-attitude", &[input, "--tool", "ball.json", "--model", m, "-o", "t.csv", "--report", "r.json"], b"")
+}
+
+/// The ball's check on cl.csv finds no gouge with the faces' triangles within the asked chord
+/// (0.25 µm): its report and that chord.
+fn clear_ball_check(w: &Work, m: &str) -> (serde_json::Value, f64) {
+    ball_check(w, "cl.csv", m).ok();
+    let r: serde_json::Value = serde_json::from_str(&w.read("r.json")).unwrap();
+    let chord = r["gouge_chord_mm"].as_f64().unwrap();
+    assert!(chord > 0.0 && chord <= 0.25e-3, "{r}");
+    assert_eq!(r["gouge_rows"], 0, "{r}");
+    (r, chord)
+}
+
+/// The ball's check (`ball_check`, its input low.csv) on the table `cl` with row `k`'s tip and
 /// contact moved 0.1 mm down: it fails naming that one row, and the depth it reports.
-fn lowered_gouge(w: &Work, cl: &str, k: usize, args: &[&str]) -> f64 {
+fn lowered_gouge(w: &Work, cl: &str, k: usize, m: &str) -> f64 {
     let mut lines: Vec<String> = cl.lines().map(str::to_string).collect();
     let header: Vec<&str> = lines[0].split(',').collect();
     let (iz, ipz) = (header.iter().position(|h| *h == "z").unwrap(), header.iter().position(|h| *h == "pz").unwrap());
@@ -435,7 +435,7 @@ fn lowered_gouge(w: &Work, cl: &str, k: usize, args: &[&str]) -> f64 {
     }
     lines[k + 1] = f.join(",");
     w.write("low.csv", lines.join("\n") + "\n");
-    let o = w.run("tool-attitude", args, b"");
+    let o = ball_check(w, "low.csv", m);
     o.fails(1, &format!("low.csv:{}: 1 row(s) gouge the model by more than 0.001 mm", k + 2));
     o.stderr.split("deepest ").nth(1).unwrap().trim_end().trim_end_matches(" mm)").parse().unwrap()
 }

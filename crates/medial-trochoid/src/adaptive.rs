@@ -595,24 +595,7 @@ fn front_start(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::feed::FeedModel;
-    use crate::medial::MedialOptions;
     use camkit::geom::arc::angle_of;
-
-    fn settings(r: f64) -> Settings {
-        Settings {
-            radius: r,
-            step: 1.0,
-            threshold: 40.0,
-            trochoid_radius: 0.5 * r,
-            pitch: None,
-            allowance: 0.0,
-            corner_radius: None,
-            sample: 0.5,
-            medial: MedialOptions { resolution: 1e-6, sagitta: 1e-3, chord_error: 1e-3 },
-            feed: FeedModel { spindle: 4800.0, teeth: 6.0, chip: 0.03, fz_max: 0.1, force_at: Some(40.0) },
-        }
-    }
 
     /// An L-shaped pocket (a 40 × 20 and a 20 × 40 leg) with a square island.
     fn l_pocket() -> Vec<Region> {
@@ -633,7 +616,7 @@ mod tests {
         // right of travel (climb with a clockwise spindle): their middle within a half turn
         // clockwise of the heading.
         let r = 3.0;
-        let s = settings(r);
+        let s = Settings::for_tests(r);
         let regions = l_pocket();
         let plan = plan_adaptive(&regions, &s, None).expect("a plan");
         let a = crate::analyse(plan.program.clone(), &s, &regions);

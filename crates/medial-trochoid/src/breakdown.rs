@@ -95,8 +95,6 @@ impl Breakdown {
 mod tests {
     use super::*;
     use crate::Settings;
-    use crate::feed::FeedModel;
-    use crate::medial::MedialOptions;
     use crate::program::{Move, Program};
     use camkit::contour::Contour;
     use camkit::contour::Seg;
@@ -109,18 +107,7 @@ mod tests {
         // slot's own ground, a side cut at the 40° step, a light cut 0.05 mm further and air
         // back along y = 10.
         let r = 2.0;
-        let s = Settings {
-            radius: r,
-            step: 1.0,
-            threshold: 40.0,
-            trochoid_radius: 1.0,
-            pitch: None,
-            allowance: 0.0,
-            corner_radius: None,
-            sample: 0.5,
-            medial: MedialOptions { resolution: 1e-6, sagitta: 1e-3, chord_error: 1e-3 },
-            feed: FeedModel { spindle: 4800.0, teeth: 6.0, chip: 0.03, fz_max: 0.1, force_at: Some(40.0) },
-        };
+        let s = Settings::for_tests(r);
         let outer =
             Contour::polygon(&[P2::new(0.0, 0.0), P2::new(60.0, 0.0), P2::new(60.0, 40.0), P2::new(0.0, 40.0)], true);
         let (rs, _) = regions(&[outer]).expect("a region");

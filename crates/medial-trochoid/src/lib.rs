@@ -66,6 +66,26 @@ pub struct Settings {
     pub feed: FeedModel,
 }
 
+#[cfg(test)]
+impl Settings {
+    /// Unit tests' settings for tool radius `r`: 40° at a 1 mm step, loops of r/2, samples every
+    /// 0.5 mm, a fine medial axis and the force-limited feed model.
+    pub(crate) fn for_tests(r: f64) -> Settings {
+        Settings {
+            radius: r,
+            step: 1.0,
+            threshold: 40.0,
+            trochoid_radius: 0.5 * r,
+            pitch: None,
+            allowance: 0.0,
+            corner_radius: None,
+            sample: 0.5,
+            medial: MedialOptions { resolution: 1e-6, sagitta: 1e-3, chord_error: 1e-3 },
+            feed: FeedModel { spindle: 4800.0, teeth: 6.0, chip: 0.03, fz_max: 0.1, force_at: Some(40.0) },
+        }
+    }
+}
+
 /// A program of one layer with its simulated engagement.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Analysed {

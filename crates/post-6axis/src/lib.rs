@@ -213,15 +213,9 @@ pub const ANGLE_MARGIN: f64 = 0.8;
 /// Samples per block in the read-back check.
 pub const CHECK_SAMPLES: usize = 8;
 
-/// Plans, writes and reads back the program for CL rows.
-pub fn post(
-    rows: &[Cl],
-    file: &str,
-    machine: &Machine,
-    chain: &Chain,
-    s: &Settings,
-    comments: Vec<String>,
-) -> Result<Posted> {
+/// What planning works to for `rows` on `machine`: the tolerances less what the program's
+/// decimals may add in rounding (refused when that leaves under a quarter of one).
+fn plan_options(rows: &[Cl], machine: &Machine, chain: &Chain, s: &Settings) -> Result<plan::Options> {
     let allowance = rounding_allowance(rows, chain, machine);
     let tol_used = s.tol - allowance;
     if tol_used < s.tol / 4.0 {
@@ -253,7 +247,7 @@ pub fn post(
             s.spindle_tol
         )));
     }
-    let opts = plan::Options {
+    Ok(plan::Options {
         tol: tol_used,
         angle_tol: angle_used.to_radians(),
         // The check measures the spindle against the CL at the tip's nearest point, planning at the
@@ -261,7 +255,19 @@ pub fn post(
         spindle_tol: s.spindle_tol * SPINDLE_MARGIN,
         tcp: machine.program.tcp,
         interpolate_singular: machine.singular == camkit::doc::machine::SingularRule::Interpolate,
-    };
+    })
+}
+
+/// Plans, writes and reads back the program for CL rows.
+pub fn post(
+    rows: &[Cl],
+    file: &str,
+    machine: &Machine,
+    chain: &Chain,
+    s: &Settings,
+    comments: Vec<String>,
+) -> Result<Posted> {
+    let opts = plan_options(rows, machine, chain, s)?;
     let m = planning(machine, chain);
     // Blocks are written as they are planned; a move without a feed is refused once planning
     // has found nothing worse (as when the whole plan came first).
@@ -284,7 +290,7 @@ pub fn post(
     let (text, written) = writer.finish();
     let check = check_text(&text, rows, machine, chain, s.tol)?;
     judge(&check, rows, machine, s)?;
-    Ok(Posted { text, plan: stats, written, check, tol_used })
+    Ok(Posted { text, plan: stats, written, check, tol_used: opts.tol })
 }
 
 /// The verdict on a program read back: a check failure (exit 1) naming where it misses if the tip,
@@ -476,17 +482,7 @@ mod tests {
             rows.extend(pass(30, 20.0, -90.0, 2.0, m.spindle.is_some()));
             let s = Settings { tol: 0.002, ..Settings::default() };
             let posted = post(&rows, "t", &m, &chain, &s, vec!["c".into()]).expect("posts");
-            let allowance = rounding_allowance(&rows, &chain, &m);
-            let d = m.program.decimals;
-            let opts = plan::Options {
-                tol: s.tol - allowance,
-                angle_tol: (s.angle_tol * ANGLE_MARGIN
-                    - 0.5 * 10f64.powi(-(d.rotary as i32)) * chain.rotaries().len() as f64)
-                    .to_radians(),
-                spindle_tol: s.spindle_tol * SPINDLE_MARGIN,
-                tcp: m.program.tcp,
-                interpolate_singular: m.singular == camkit::doc::machine::SingularRule::Interpolate,
-            };
+            let opts = plan_options(&rows, &m, &chain, &s).unwrap();
             let (steps, stats) = plan::plan(&rows, &planning(&m, &chain), &opts).expect("plans");
             assert!(stats.inserted > 0, "{name}: {stats:?}");
             let wopts = nc::WriteOptions { rotary_radius: s.rotary_radius, comments: vec!["c".into()] };

@@ -70,6 +70,15 @@ impl Aabb {
         nalgebra::center(&self.min, &self.max)
     }
 
+    /// Distance from the point `q` of the xy plane to the box's shadow on it (0 inside): how near
+    /// the z axis through `q` anything in the box can be.
+    #[inline]
+    pub fn dist_xy(&self, q: [f64; 2]) -> f64 {
+        let dx = (self.min.x - q[0]).max(q[0] - self.max.x).max(0.0);
+        let dy = (self.min.y - q[1]).max(q[1] - self.max.y).max(0.0);
+        dx.hypot(dy)
+    }
+
     /// Squared distance from `p` to the box (0 inside): a lower bound for anything in it.
     #[inline]
     pub fn dist2(&self, p: &P3) -> f64 {

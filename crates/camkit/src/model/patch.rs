@@ -53,6 +53,23 @@ pub struct Derivs {
     pub svv: V3,
 }
 
+#[cfg(test)]
+impl Derivs {
+    /// Checks the derivatives of `eval` at (u, v) against central differences of its lower orders.
+    pub(crate) fn assert_match_differences(eval: impl Fn(f64, f64) -> Derivs, u: f64, v: f64) {
+        let h = 1e-6;
+        let d = eval(u, v);
+        let du = (eval(u + h, v).s - eval(u - h, v).s) / (2.0 * h);
+        let dv = (eval(u, v + h).s - eval(u, v - h).s) / (2.0 * h);
+        let duu = (eval(u + h, v).su - eval(u - h, v).su) / (2.0 * h);
+        let duv = (eval(u, v + h).su - eval(u, v - h).su) / (2.0 * h);
+        let dvv = (eval(u, v + h).sv - eval(u, v - h).sv) / (2.0 * h);
+        for (a, b) in [(d.su, du), (d.sv, dv), (d.suu, duu), (d.suv, duv), (d.svv, dvv)] {
+            assert!((a - b).norm() < 1e-5 * (1.0 + a.norm()), "{a} vs {b}");
+        }
+    }
+}
+
 /// Clamped uniform knots for `n` points of degree `p` on [0, 1].
 pub fn clamped_uniform(n: usize, p: usize) -> Vec<f64> {
     let inner = n - p;
@@ -501,16 +518,7 @@ mod tests {
     #[test]
     fn derivatives_match_differences() {
         let s = BSpline::new(&net(7), [3, 3], None, None);
-        let (u, v, h) = (0.37, 0.61, 1e-6);
-        let d = s.eval(u, v);
-        let du = (s.eval(u + h, v).s - s.eval(u - h, v).s) / (2.0 * h);
-        let dv = (s.eval(u, v + h).s - s.eval(u, v - h).s) / (2.0 * h);
-        let duu = (s.eval(u + h, v).su - s.eval(u - h, v).su) / (2.0 * h);
-        let duv = (s.eval(u, v + h).su - s.eval(u, v - h).su) / (2.0 * h);
-        let dvv = (s.eval(u, v + h).sv - s.eval(u, v - h).sv) / (2.0 * h);
-        for (a, b) in [(d.su, du), (d.sv, dv), (d.suu, duu), (d.suv, duv), (d.svv, dvv)] {
-            assert!((a - b).norm() < 1e-5 * (1.0 + a.norm()), "{a} vs {b}");
-        }
+        Derivs::assert_match_differences(|u, v| s.eval(u, v), 0.37, 0.61);
         // A clamped B-spline interpolates its corner points.
         assert!((s.eval(0.0, 0.0).s - P3::new(0.0, 0.0, 0.0)).norm() < 1e-12);
         assert!((s.eval(1.0, 1.0).s - net(7)[6][6]).norm() < 1e-12);

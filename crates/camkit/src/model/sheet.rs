@@ -469,19 +469,18 @@ fn beyond(c: &Cutter, q: [f64; 2], net: &Bezier, b: &Aabb) -> bool {
     len > 0.0 && net.points().all(|p| ((p.x - q[0]) * dx + (p.y - q[1]) * dy) / len > c.radius())
 }
 
-/// True when g = z − f(ρ) has no stationary point on the piece, so that its largest value on the
-/// piece's part in a face lies on the face's boundary or on the piece's sides. Needs the piece's
-/// box in the open shadow (off the cone's tip, where f has no slope), and along s or along t the
-/// derivative of g of one sign all over it: ∂g/∂s = m·S_s with m = (−f′(ρ) d̂, 1), d̂ the
-/// direction from the axis, and S_s of a rational piece with positive weights is a positive
-/// combination of differences of control points of consecutive rows, any columns (the hodograph
-/// of a rational Bézier curve lies in the cone of its control points' differences, Floater 1992);
-/// so the sign holds when m·D has it for every such D and every m over the box.
-fn monotone(c: &Cutter, q: [f64; 2], net: &Bezier) -> bool {
-    let b = net.bounds();
+/// True when g = z − f(ρ) has no stationary point on the piece `net` (box `b`), so that its largest
+/// value on the piece's part in a face lies on the face's boundary or on the piece's sides. Needs
+/// the piece's box in the open shadow (off the cone's tip, where f has no slope), and along s or
+/// along t the derivative of g of one sign all over it: ∂g/∂s = m·S_s with m = (−f′(ρ) d̂, 1), d̂
+/// the direction from the axis, and S_s of a rational piece with positive weights is a positive
+/// combination of differences of control points of consecutive rows, any columns (the hodograph of
+/// a rational Bézier curve lies in the cone of its control points' differences, Floater 1992); so
+/// the sign holds when m·D has it for every such D and every m over the box.
+fn monotone(c: &Cutter, q: [f64; 2], net: &Bezier, b: &Aabb) -> bool {
     let corners = [(b.min.x, b.min.y), (b.max.x, b.min.y), (b.max.x, b.max.y), (b.min.x, b.max.y)];
     let far = corners.iter().map(|p| (p.0 - q[0]).hypot(p.1 - q[1])).fold(0.0, f64::max);
-    let near = (b.min.x - q[0]).max(q[0] - b.max.x).max(0.0).hypot((b.min.y - q[1]).max(q[1] - b.max.y).max(0.0));
+    let near = b.dist_xy(q);
     if far >= c.radius() || (near == 0.0 && matches!(c, Cutter::Cone { .. })) {
         return false;
     }
@@ -562,9 +561,7 @@ impl Sheet {
     /// is steep enough to give one; −∞ where it is out of the shadow.
     fn bound(&self, c: &Cutter, q: [f64; 2], net: &Bezier, full: bool) -> f64 {
         let b = net.bounds();
-        let dx = (b.min.x - q[0]).max(q[0] - b.max.x).max(0.0);
-        let dy = (b.min.y - q[1]).max(q[1] - b.max.y).max(0.0);
-        let rho = dx.hypot(dy);
+        let rho = b.dist_xy(q);
         if rho > c.radius() || beyond(c, q, net, &b) {
             return f64::NEG_INFINITY;
         }
@@ -639,9 +636,7 @@ impl Sheet {
         // leave out.
         if let Some(trim) = &self.face {
             for (e, b) in &trim.edges {
-                let dx = (b.min.x - q[0]).max(q[0] - b.max.x).max(0.0);
-                let dy = (b.min.y - q[1]).max(q[1] - b.max.y).max(0.0);
-                let rho = dx.hypot(dy);
+                let rho = b.dist_xy(q);
                 if rho > big_r || b.max.z - c.height(rho * (1.0 - RHO_ROUND)) <= level(&best) {
                     continue;
                 }
@@ -728,7 +723,7 @@ impl Sheet {
             // sides (held by the pieces beside it) and the face's boundary (dropped onto first)
             // give: the bound of a piece across the boundary holds the carrier beyond it, which
             // would otherwise be halved down to nothing along the whole boundary.
-            if self.face.is_some() && monotone(c, q, &node.net) {
+            if self.face.is_some() && monotone(c, q, &node.net, &b) {
                 continue;
             }
             let (a, b) = node.net.split(dir);

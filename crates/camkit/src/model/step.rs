@@ -736,12 +736,8 @@ mod tests {
             // The densest sample, then golden sections on its neighbourhood.
             let k: usize = 100_000;
             let i = (0..=k).min_by(|a, b| d(*a as f64 / k as f64).total_cmp(&d(*b as f64 / k as f64))).unwrap();
-            let (mut a, mut b) = (i.saturating_sub(1) as f64 / k as f64, ((i + 1).min(k)) as f64 / k as f64);
-            for _ in 0..100 {
-                let (c, e) = (b - (b - a) * 0.618, a + (b - a) * 0.618);
-                if d(c) < d(e) { b = e } else { a = c }
-            }
-            let want = d(0.5 * (a + b));
+            let (a, b) = (i.saturating_sub(1) as f64 / k as f64, ((i + 1).min(k)) as f64 / k as f64);
+            let want = d(crate::num::golden_arg(|t| -d(t), a, b, 100));
             assert!(m.surfaces[n.surface].name.starts_with("revolution"), "{q}: {}", m.surfaces[n.surface].name);
             assert!((n.distance - want).abs() < 1e-7, "{q}: {} vs {want}", n.distance);
             // Outward: along q − foot outside the knob, against it inside.
