@@ -18,7 +18,7 @@
 
 use super::analytic::{Analytic, Foot};
 use super::bvh::Aabb;
-use super::patch::{BSpline, FOOT_TOL, basis_derivs, find_span};
+use super::patch::{BSpline, FOOT_TOL, basis, basis_derivs, find_span};
 use super::revolution::Revolution;
 use crate::geom::{P3, V3};
 use std::f64::consts::{PI, TAU};
@@ -61,6 +61,13 @@ pub struct SplineCurve {
     pub knots: Vec<f64>,
 }
 
+/// Points of a B-spline curve at evenly spaced parameters, where a nearest-point search starts.
+#[derive(Clone, Debug)]
+pub struct Samples {
+    ts: Vec<f64>,
+    pts: Vec<P3>,
+}
+
 impl SplineCurve {
     /// Parameter domain.
     pub fn domain(&self) -> [f64; 2] {
@@ -87,18 +94,48 @@ impl SplineCurve {
         (P3::from(c), c1, c2)
     }
 
+    /// Point at `t`: bit for bit `eval(t).0`, without the derivatives (the nearest-point
+    /// search's samples and the outlines' points need none).
+    pub fn point(&self, t: f64) -> P3 {
+        let (p, n) = (self.degree, self.ctrl.len());
+        let s = find_span(&self.knots, n, p, t);
+        let b = basis(&self.knots, s, p, t);
+        let (mut a, mut w) = (V3::zeros(), 0.0);
+        for k in s - p..=s {
+            let wk = self.weights.as_ref().map_or(1.0, |ws| ws[k]);
+            let basis = wk * b[k + p - s];
+            a += self.ctrl[k].coords * basis;
+            w += basis;
+        }
+        P3::from(a / w)
+    }
+
     /// Number of non-empty knot spans in [t0, t1].
     fn spans(&self, t0: f64, t1: f64) -> usize {
         let k = &self.knots[self.degree..=self.ctrl.len()];
         k.windows(2).filter(|w| w[1] > w[0] && w[1] > t0 && w[0] < t1).count().max(1)
     }
 
-    /// The parameter in [t0, t1] of the nearest point to `q`, and whether it converged.
-    pub fn nearest(&self, q: &P3, t0: f64, t1: f64) -> (f64, bool) {
+    /// The nearest-point search's samples over [t0, t1]: [`SPLINE_SAMPLES`] a span.
+    pub fn samples(&self, t0: f64, t1: f64) -> Samples {
         let m = SPLINE_SAMPLES * self.spans(t0, t1);
         let ts: Vec<f64> = (0..=m).map(|i| t0 + (t1 - t0) * i as f64 / m as f64).collect();
-        let d2 = |t: f64| (self.eval(t).0 - q).norm_squared();
-        let i = (0..=m).min_by(|&a, &b| d2(ts[a]).total_cmp(&d2(ts[b]))).expect("samples");
+        let pts = ts.iter().map(|&t| self.point(t)).collect();
+        Samples { ts, pts }
+    }
+
+    /// The parameter in [t0, t1] of the nearest point to `q`, and whether it converged.
+    pub fn nearest(&self, q: &P3, t0: f64, t1: f64) -> (f64, bool) {
+        self.nearest_in(q, &self.samples(t0, t1))
+    }
+
+    /// [`SplineCurve::nearest`] over the span of `samples` (made by [`SplineCurve::samples`] and
+    /// kept by whoever asks often): the nearest sample, then Newton's method beside it.
+    pub fn nearest_in(&self, q: &P3, samples: &Samples) -> (f64, bool) {
+        let Samples { ts, pts } = samples;
+        let m = ts.len() - 1;
+        let d2 = pts.iter().map(|p| (p - q).norm_squared()).enumerate();
+        let (i, _) = d2.min_by(|a, b| a.1.total_cmp(&b.1)).expect("samples");
         // g(t) = (C − q)·C' is the derivative of |C − q|²/2; its sign says which way is down.
         let g = |t: f64| {
             let (c, c1, c2) = self.eval(t);
@@ -173,7 +210,7 @@ pub enum Curve {
         /// End angle.
         t1: f64,
     },
-    /// A B-spline curve over [t0, t1].
+    /// A B-spline curve over [t0, t1] (made by [`Curve::spline`]).
     Spline {
         /// The curve.
         curve: SplineCurve,
@@ -181,10 +218,18 @@ pub enum Curve {
         t0: f64,
         /// End parameter.
         t1: f64,
+        /// The nearest-point search's samples over [t0, t1], made once.
+        samples: Samples,
     },
 }
 
 impl Curve {
+    /// The B-spline edge of `curve` over [t0, t1], with its search samples.
+    pub fn spline(curve: SplineCurve, t0: f64, t1: f64) -> Curve {
+        let samples = curve.samples(t0, t1);
+        Curve::Spline { curve, t0, t1, samples }
+    }
+
     /// The exact (lines, arcs) or converged nearest point to `q`.
     pub fn nearest(&self, q: &P3) -> (P3, bool) {
         match self {
@@ -206,9 +251,9 @@ impl Curve {
                 let (a, b) = (at(*t0), at(*t1));
                 (if (a - q).norm_squared() <= (b - q).norm_squared() { a } else { b }, true)
             }
-            Curve::Spline { curve, t0, t1 } => {
-                let (t, converged) = curve.nearest(q, *t0, *t1);
-                (curve.eval(t).0, converged)
+            Curve::Spline { curve, samples, .. } => {
+                let (t, converged) = curve.nearest_in(q, samples);
+                (curve.point(t), converged)
             }
         }
     }
@@ -234,19 +279,19 @@ impl Curve {
                     })
                     .collect()
             }
-            Curve::Spline { curve, t0, t1 } => {
+            Curve::Spline { curve, t0, t1, .. } => {
                 let n = SPLINE_SAMPLES * curve.spans(*t0, *t1);
                 let ts: Vec<f64> = (0..=n).map(|i| t0 + (t1 - t0) * i as f64 / n as f64).collect();
-                let mut out = vec![curve.eval(ts[0]).0];
+                let mut out = vec![curve.point(ts[0])];
                 for w in ts.windows(2) {
-                    let b = curve.eval(w[1]).0;
+                    let b = curve.point(w[1]);
                     let mut k = 1usize;
                     while k < 1 << 12 {
                         let sag = (0..k)
                             .map(|i| {
                                 let at = |j: f64| w[0] + (w[1] - w[0]) * j / k as f64;
-                                let (p, q) = (curve.eval(at(i as f64)).0, curve.eval(at(i as f64 + 1.0)).0);
-                                (curve.eval(at(i as f64 + 0.5)).0 - (p + q.coords) / 2.0).norm()
+                                let (p, q) = (curve.point(at(i as f64)), curve.point(at(i as f64 + 1.0)));
+                                (curve.point(at(i as f64 + 0.5)) - (p + q.coords) / 2.0).norm()
                             })
                             .fold(0.0, f64::max);
                         if sag <= chord {
@@ -254,7 +299,7 @@ impl Curve {
                         }
                         k *= 2;
                     }
-                    out.extend((1..k).map(|i| curve.eval(w[0] + (w[1] - w[0]) * i as f64 / k as f64).0));
+                    out.extend((1..k).map(|i| curve.point(w[0] + (w[1] - w[0]) * i as f64 / k as f64)));
                     out.push(b);
                 }
                 out
@@ -1093,7 +1138,7 @@ mod tests {
             weights: Some(vec![1.0, h, 1.0]),
             knots: vec![0.0, 0.0, 0.0, 1.0, 1.0, 1.0],
         };
-        let edge = Curve::Spline { curve, t0: 0.0, t1: 1.0 };
+        let edge = Curve::spline(curve, 0.0, 1.0);
         for (x, y, z) in [(20.0, 3.0, 1.0), (1.0, 2.0, -4.0), (7.0, 7.0, 0.0)] {
             let (p, ok) = edge.nearest(&P3::new(x, y, z));
             let e = V3::new(x, y, 0.0).normalize() * 10.0;
@@ -1101,5 +1146,22 @@ mod tests {
         }
         let (p, ok) = edge.nearest(&P3::new(5.0, -9.0, 0.0));
         assert!(ok && (p - P3::new(10.0, 0.0, 0.0)).norm() < 1e-12, "{p}");
+    }
+
+    /// The point-only evaluation the nearest-point search samples with is the full evaluation's
+    /// point to the bit (a rational cubic of three spans, at knots, inside spans and at the ends),
+    /// so the search's samples and the outlines are what they were with the derivatives.
+    #[test]
+    fn spline_point_is_the_evaluations_point_to_the_bit() {
+        let curve = SplineCurve {
+            degree: 3,
+            ctrl: (0..6).map(|i| P3::new(i as f64 * 3.1, (i as f64 * 1.7).sin() * 5.0, 0.3 * i as f64)).collect(),
+            weights: Some(vec![1.0, 0.7, 1.3, 0.9, 1.1, 1.0]),
+            knots: vec![0.0, 0.0, 0.0, 0.0, 0.4, 0.75, 1.0, 1.0, 1.0, 1.0],
+        };
+        for i in 0..=1000 {
+            let t = i as f64 / 1000.0;
+            assert_eq!(curve.point(t), curve.eval(t).0, "t = {t}");
+        }
     }
 }

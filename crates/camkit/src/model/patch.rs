@@ -111,9 +111,9 @@ pub(super) fn find_span(knots: &[f64], n: usize, p: usize, t: f64) -> usize {
     lo
 }
 
-/// Basis functions of degree `p` at `t` in span `s` and their first two derivatives (The NURBS
-/// Book, A2.3): `out[k][j]` is the k-th derivative of N_{s−p+j}.
-pub(super) fn basis_derivs(knots: &[f64], s: usize, p: usize, t: f64) -> [[f64; MAX_DEGREE + 1]; 3] {
+/// The triangle of basis functions of degree 0..=`p` at `t` in span `s` and the knot differences
+/// (The NURBS Book, A2.2/A2.3's `ndu`): `ndu[j][p]` is N_{s−p+j}.
+fn basis_table(knots: &[f64], s: usize, p: usize, t: f64) -> [[f64; MAX_DEGREE + 1]; MAX_DEGREE + 1] {
     const M: usize = MAX_DEGREE + 1;
     let mut ndu = [[0.0f64; M]; M];
     let mut left = [0.0f64; M];
@@ -131,6 +131,21 @@ pub(super) fn basis_derivs(knots: &[f64], s: usize, p: usize, t: f64) -> [[f64; 
         }
         ndu[j][j] = saved;
     }
+    ndu
+}
+
+/// Basis functions of degree `p` at `t` in span `s` without derivatives: `out[j]` is
+/// N_{s−p+j}, bit for bit the first row of [`basis_derivs`].
+pub(super) fn basis(knots: &[f64], s: usize, p: usize, t: f64) -> [f64; MAX_DEGREE + 1] {
+    let ndu = basis_table(knots, s, p, t);
+    std::array::from_fn(|j| if j <= p { ndu[j][p] } else { 0.0 })
+}
+
+/// Basis functions of degree `p` at `t` in span `s` and their first two derivatives (The NURBS
+/// Book, A2.3): `out[k][j]` is the k-th derivative of N_{s−p+j}.
+pub(super) fn basis_derivs(knots: &[f64], s: usize, p: usize, t: f64) -> [[f64; MAX_DEGREE + 1]; 3] {
+    const M: usize = MAX_DEGREE + 1;
+    let ndu = basis_table(knots, s, p, t);
     let mut ders = [[0.0f64; M]; 3];
     for j in 0..=p {
         ders[0][j] = ndu[j][p];

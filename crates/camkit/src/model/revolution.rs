@@ -8,7 +8,7 @@
 
 use super::analytic::Foot;
 use super::bvh::Aabb;
-use super::face::SplineCurve;
+use super::face::{Samples, SplineCurve};
 use super::patch::Derivs;
 use crate::geom::{P3, V3};
 
@@ -19,6 +19,8 @@ pub struct Revolution {
     profile: SplineCurve,
     /// True when the profile is a closed curve (v is then periodic).
     closed: bool,
+    /// The profile's nearest-point samples over its domain, made once.
+    samples: Samples,
 }
 
 impl Revolution {
@@ -28,7 +30,8 @@ impl Revolution {
         let [t0, t1] = profile.domain();
         let (a, b) = (profile.eval(t0).0, profile.eval(t1).0);
         let closed = (a - b).norm() <= 1e-9 * (1.0 + a.coords.norm());
-        Revolution { profile, closed }
+        let samples = profile.samples(t0, t1);
+        Revolution { profile, closed, samples }
     }
 
     /// Parameter domain [u0, u1, v0, v1]: u the angle about z, v the profile's parameter.
@@ -81,8 +84,7 @@ impl Revolution {
     pub fn nearest(&self, q: &P3, bound: f64) -> Option<(Foot, [f64; 2], bool)> {
         let rho = q.x.hypot(q.y);
         let u = if rho > 0.0 { q.y.atan2(q.x) } else { 0.0 };
-        let [_, _, v0, v1] = self.domain();
-        let (v, converged) = self.profile.nearest(&P3::new(rho, 0.0, q.z), v0, v1);
+        let (v, converged) = self.profile.nearest_in(&P3::new(rho, 0.0, q.z), &self.samples);
         let d = self.eval(u, v);
         if (d.s - q).norm() > bound {
             return None;

@@ -276,7 +276,7 @@ impl Trim {
                         ));
                     }
                 }
-                Curve::Spline { curve, t0, t1 } => {
+                Curve::Spline { curve, t0, t1, .. } => {
                     let p = curve.degree;
                     let rows = (0..curve.ctrl.len())
                         .map(|k| {

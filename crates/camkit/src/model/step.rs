@@ -526,7 +526,7 @@ impl Reader<'_> {
                 } else {
                     curve.nearest(&b, 0.0, ELLIPSE_DOMAIN).0
                 };
-                Ok(Curve::Spline { curve, t0: 0.0, t1 })
+                Ok(Curve::spline(curve, 0.0, t1))
             }
             _ if c.part("B_SPLINE_CURVE_WITH_KNOTS").is_some() => {
                 let mut curve = self.bspline_curve(cid)?;
@@ -539,7 +539,7 @@ impl Reader<'_> {
                     let tb = curve.nearest(&b, d0, d1).0;
                     (ta.min(tb), ta.max(tb))
                 };
-                Ok(Curve::Spline { curve, t0, t1 })
+                Ok(Curve::spline(curve, t0, t1))
             }
             _ => Err(self.unsupported(cid, "an edge curve", CURVES)),
         }
