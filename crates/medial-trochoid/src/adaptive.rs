@@ -327,7 +327,6 @@ pub fn plan_adaptive(regions: &[Region], s: &Settings, unit: Option<f64>) -> Res
                 cutting.push(seg);
                 m.clear(&seg, w.r);
             }
-            out.retracts += 1;
             clear_from(&mut cutting, &mut m, region, &w, (c0 + V2::new(rh, 0.0), FRAC_PI_2), &mut given_up, &mut out);
         }
         let left: Vec<P2> = (0..m.left.len()).filter(|&k| m.left[k]).map(|k| m.point(k)).collect();
@@ -335,6 +334,9 @@ pub fn plan_adaptive(regions: &[Region], s: &Settings, unit: Option<f64>) -> Res
         out.uncut.extend(left);
         out.uncut.extend(given_up);
     }
+    // Counted where written: a retract planned before a pass that then cuts nothing, or before
+    // no pass at all, is none.
+    out.retracts = out.program.moves.iter().filter(|m| m.retract_before).count();
     // Entries alone (no pass holds the target anywhere) are no program: the tool is too large.
     if out.passes == 0 {
         return Err(PlanError::NoPasses);
@@ -394,7 +396,6 @@ fn clear_from(
                 retract_next = false;
             } else {
                 retract_next = true;
-                out.retracts += 1;
             }
         }
         at = next;
