@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """Fuzz `offset` with random star pockets of lines and arcs (round islands sometimes): every run
 must give a verified result (exit 0) or refuse the input naming a crossing (exit 2). Anything
-else (exit 1: no verified offset; a crash) is a defect and its input is kept.
+else (exit 1: no verified offset; a crash) is a defect and its input is kept as
+$TMPDIR/fuzz-offset-defects/<family>-<seed>.csv (rerun it with the options the summary prints).
 
   scripts/fuzz-offset.py [SEEDS [FIRST]] [--spiky | --fine | --fillets | --far | --tiny | --open | --wiggle]
                                              (offset binary: $OFFSET or target/release/offset)
@@ -15,7 +16,7 @@ x = 1e5, y = -3e4 mm; --tiny scales the star and every radius and step by 1/100.
 a smooth closed curve r = 50 + a sin(m t + p) + b sin(M t + q) with 3 000-60 000 lines (issue 20,
 D13), its tightest bends near the radii offset by (0.3-1 mm), both sides and a pocket's first levels.
 """
-import math, os, random, subprocess, sys, tempfile
+import math, os, random, shutil, subprocess, sys, tempfile
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from fuzzkit import arc_centre, binary  # noqa: E402
@@ -170,6 +171,7 @@ def main():
         runs = [["--side", side, "--radius", str(r)] for side in ("left", "right") for r in (0.3, 0.5, 1)]
         runs += [["--radius", "0.5", "--step", "0.5", "--repeat", "2"]]
     counts, kept = {"ok": 0, "refused": 0, "defect": 0}, []
+    keep = os.path.join(os.environ.get("TMPDIR", "/tmp"), "fuzz-offset-defects")
     with tempfile.TemporaryDirectory() as tmp:
         src, out = os.path.join(tmp, "star.csv"), os.path.join(tmp, "out.csv")
         for seed in range(first, first + seeds):
@@ -183,7 +185,10 @@ def main():
                     counts["refused"] += 1
                 else:
                     counts["defect"] += 1
-                    kept.append(f"seed {seed} {' '.join(run)}: exit {p.returncode}: {p.stderr.strip()[:200]}")
+                    os.makedirs(keep, exist_ok=True)
+                    saved = shutil.copy(src, os.path.join(keep, f"{family}-{seed}.csv"))
+                    kept.append(f"seed {seed} {' '.join(run)} (input kept as {saved}): exit {p.returncode}: "
+                                f"{p.stderr.strip()[:200]}")
     print(f"{seeds} stars ({family}), {sum(counts.values())} runs: {counts}")
     for k in kept[:20]:
         print(k)
