@@ -886,8 +886,8 @@ fn numeric_options_and_mutated_documents_are_refused_or_posted() {
     assert!(seen[0] > 20 && seen[2] > 100, "{seen:?}");
 }
 
-/// The table is read as a stream (issue 20): from a file and from standard input (copied to a
-/// temporary file), with CRLF line ends, comment and blank lines, it gives the same program as
+/// The table is read as a stream (issue 20): from a file, from standard input and from a pipe
+/// named as a file (both copied to a temporary file), with CRLF line ends, comment and blank lines, it gives the same program as
 /// the plain file; a bad number on the last row, which has no line end, is named with its line
 /// and column (exit 2) and no program is written.
 #[test]
@@ -906,12 +906,15 @@ fn rows_streamed_from_a_file_or_stdin_and_a_fault_on_the_last_row() {
     w.write("crlf.csv", &crlf);
     w.run(BIN, &args("crlf.csv", "crlf.nc"), b"").ok();
     w.run(BIN, &args("-", "stdin.nc"), crlf.as_bytes()).ok();
+    // A pipe named as a file (`<(…)`) reads once: copied first, as standard input is.
+    w.run(BIN, &args("/dev/stdin", "pipe.nc"), crlf.as_bytes()).ok();
     let program = w.read("plain.nc");
     assert!(program.lines().count() > rows.len(), "{} blocks", program.lines().count());
     // The header comment names the input; the blocks are the same.
     let blocks = |nc: &str| nc.lines().filter(|l| !l.starts_with('(')).map(str::to_string).collect::<Vec<_>>();
     assert_eq!(blocks(&w.read("crlf.nc")), blocks(&program));
     assert_eq!(blocks(&w.read("stdin.nc")), blocks(&program));
+    assert_eq!(blocks(&w.read("pipe.nc")), blocks(&program));
     let mut bad = crlf.trim_end().to_string();
     bad.truncate(bad.rfind(',').unwrap());
     bad.push_str(",8x0");
