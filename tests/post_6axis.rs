@@ -885,3 +885,40 @@ fn numeric_options_and_mutated_documents_are_refused_or_posted() {
     eprintln!("outcomes (exit 0, 1, 2): {seen:?}");
     assert!(seen[0] > 20 && seen[2] > 100, "{seen:?}");
 }
+
+/// The table is read as a stream (issue 20): from a file, from standard input and from a pipe
+/// named as a file (both copied to a temporary file), with CRLF line ends, comment and blank lines, it gives the same program as
+/// the plain file; a bad number on the last row, which has no line end, is named with its line
+/// and column (exit 2) and no program is written.
+#[test]
+fn rows_streamed_from_a_file_or_stdin_and_a_fault_on_the_last_row() {
+    let w = Work::new();
+    let rows = sphere_scan(P3::new(0.0, 0.0, -40.0), 60.0, &[-20.0, 0.0, 25.0], 30.0, 1.0, 10.0, false);
+    let plain = csv(&rows, 800.0);
+    w.write("cl.csv", &plain);
+    let m = machine("paper002-ac.json");
+    let args = |input: &'static str, out: &'static str| [input, "--machine", m.as_str(), "-o", out];
+    w.run(BIN, &args("cl.csv", "plain.nc"), b"").ok();
+    let mut lines: Vec<&str> = plain.lines().collect();
+    lines.insert(1, "# scan lines over a sphere");
+    lines.insert(40, "   ");
+    let crlf = lines.join("\r\n") + "\r\n";
+    w.write("crlf.csv", &crlf);
+    w.run(BIN, &args("crlf.csv", "crlf.nc"), b"").ok();
+    w.run(BIN, &args("-", "stdin.nc"), crlf.as_bytes()).ok();
+    // A pipe named as a file (`<(…)`) reads once: copied first, as standard input is.
+    w.run(BIN, &args("/dev/stdin", "pipe.nc"), crlf.as_bytes()).ok();
+    let program = w.read("plain.nc");
+    assert!(program.lines().count() > rows.len(), "{} blocks", program.lines().count());
+    // The header comment names the input; the blocks are the same.
+    let blocks = |nc: &str| nc.lines().filter(|l| !l.starts_with('(')).map(str::to_string).collect::<Vec<_>>();
+    assert_eq!(blocks(&w.read("crlf.nc")), blocks(&program));
+    assert_eq!(blocks(&w.read("stdin.nc")), blocks(&program));
+    assert_eq!(blocks(&w.read("pipe.nc")), blocks(&program));
+    let mut bad = crlf.trim_end().to_string();
+    bad.truncate(bad.rfind(',').unwrap());
+    bad.push_str(",8x0");
+    let last = crlf.lines().count();
+    w.run(BIN, &args("-", "bad.nc"), bad.as_bytes()).fails(2, &format!("stdin:{last}:9 (f)"));
+    assert!(!w.exists("bad.nc"));
+}

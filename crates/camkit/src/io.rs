@@ -93,7 +93,8 @@ impl Input {
 }
 
 /// An input read as a stream, from its start as often as needed, never held whole: a file, or
-/// standard input copied first to an unnamed temporary file (on disk, not in memory).
+/// standard input (or a pipe named as a file) copied first to an unnamed temporary file (on disk,
+/// not in memory).
 #[derive(Debug)]
 pub struct Source {
     /// The file name as given, `stdin` for standard input.
@@ -112,6 +113,13 @@ impl Source {
         }
         let cannot = |e| Error::io(e, &format!("cannot read {arg}"));
         let file = std::fs::File::open(arg).map_err(cannot)?;
+        let meta = file.metadata().map_err(cannot)?;
+        if !meta.is_file() && !meta.is_dir() {
+            // A pipe (`<(…)`, /dev/stdin) or a device reads once: copied first, as standard input.
+            let mut copy = tempfile::tempfile().map_err(cannot)?;
+            std::io::copy(&mut &file, &mut copy).map_err(cannot)?;
+            return Ok(Source { name: arg.to_string(), file: copy });
+        }
         // A directory opens but cannot be read: say so now, as reading it whole would.
         (&file).read(&mut [0u8; 1]).map_err(cannot)?;
         Ok(Source { name: arg.to_string(), file })

@@ -579,6 +579,9 @@ impl<'a> Linker<'a> {
                 self.out.push(self.row(up, &end, true, None));
             }
         }
+        // Held to the end of the read-back check: without the slack of its doubling growth
+        // (up to a third of it; 4 MB of the 10× mould stream's rows).
+        self.out.shrink_to_fit();
         Ok(Linked { rows: self.out, stats: self.stats })
     }
 }

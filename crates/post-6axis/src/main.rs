@@ -9,7 +9,7 @@ use camkit::doc::machine::Machine;
 use camkit::doc::setup::{Job, Part};
 use camkit::error::{Error, Location, Result};
 use camkit::gcode::read_axes;
-use camkit::io::{Input, Output, write_atomic};
+use camkit::io::{Input, Output, Source, write_atomic};
 use camkit::kinematics::Chain;
 use camkit::report::Report;
 use camkit::table::meaning::{self, Meaning};
@@ -204,8 +204,8 @@ fn run(args: Args) -> Result<()> {
         finish(out, &args, report)?;
         return failed;
     }
-    let input = Input::open(&args.io.input)?;
     if args.reverse {
+        let input = Input::open(&args.io.input)?;
         let text = input.text()?;
         let program = read_axes(&input.name, text)?;
         let reading = readback::Reading::new(&machine, &chain);
@@ -222,11 +222,13 @@ fn run(args: Args) -> Result<()> {
         table::write(&mut out, &t, &WriteOptions::default())?;
         return finish(out, &args, report);
     }
-    // The rows as CL rows, read as they come: the table's rows are never held.
+    // The rows as CL rows, read as they come from the file (standard input copied to a temporary
+    // file): neither the table's rows nor its text are held.
+    let input = Source::open(&args.io.input)?;
     let mut meaning = None;
     let mut reader = None;
     let mut rows = Vec::new();
-    let schema = table::read_each(&input, &[Col::X, Col::Y], |schema, row| {
+    let schema = table::read_each_source(&input, &[Col::X, Col::Y], |schema, row| {
         let check = meaning.get_or_insert_with(|| meaning::Check::new(schema));
         check.row(&row, &input.name)?;
         if let Meaning::StylusCentre(r) = check.meaning() {
@@ -304,6 +306,9 @@ fn run(args: Args) -> Result<()> {
     progress.finish();
     report.set("post_seconds", post_started.elapsed().as_secs_f64());
     let passes = rows.iter().filter(|r| r.rapid).count();
+    // The collision check and the plot read the written program: the rows are done with.
+    let row_count = rows.len();
+    drop(rows);
     if job.is_none() && passes > 1 {
         cli::warn(&format!(
             "{passes} passes joined by straight G0 moves as given, not linked or checked against the stock: give --setup"
@@ -332,7 +337,7 @@ fn run(args: Args) -> Result<()> {
     }
     let seconds = started.elapsed().as_secs_f64();
     report
-        .set("rows", rows.len())
+        .set("rows", row_count)
         .set("normalised_axes", normalised)
         .set("blocks", posted.written.blocks)
         .set("inserted_blocks", posted.plan.inserted)
@@ -348,7 +353,7 @@ fn run(args: Args) -> Result<()> {
         .set("tol_used_mm", posted.tol_used)
         .set("angle_tol_deg", settings.angle_tol);
     deviation_keys(&mut report, &posted.check);
-    report.set("seconds", seconds).set("rows_per_second", rows.len() as f64 / seconds.max(1e-9));
+    report.set("seconds", seconds).set("rows_per_second", row_count as f64 / seconds.max(1e-9));
     finish(out, &args, report)
 }
 

@@ -120,34 +120,27 @@ pub fn samples_of(a: &NcPose, b: &NcPose, base: usize) -> usize {
     }
 }
 
-/// The CL path between two rows, made ready for many distances: the segment, the planar arc the
-/// second row arrives along (prepared in its plane), or a helix.
+/// The CL arc between two rows, made ready for many distances: the planar arc the second row
+/// arrives along (prepared in its plane), or a helix.
 #[derive(Clone, Copy, Debug)]
 enum ClPath {
-    Line(P3, P3),
     Planar(camkit::geom::Plane, PreparedArc, f64),
     Helix(crate::plan::ClArc, P3, P3, PreparedArc),
 }
 
 impl ClPath {
-    fn of(a: &Cl, b: &Cl) -> ClPath {
-        match &b.arc {
-            None => ClPath::Line(a.tip, b.tip),
-            Some(arc) => {
-                let (plane_arc, wa, wb) = arc.in_plane(&a.tip, &b.tip);
-                if wa == wb {
-                    ClPath::Planar(arc.plane, PreparedArc::new(&plane_arc), wa)
-                } else {
-                    ClPath::Helix(*arc, a.tip, b.tip, PreparedArc::new(&plane_arc))
-                }
-            }
+    fn of(arc: &crate::plan::ClArc, a: &P3, b: &P3) -> ClPath {
+        let (plane_arc, wa, wb) = arc.in_plane(a, b);
+        if wa == wb {
+            ClPath::Planar(arc.plane, PreparedArc::new(&plane_arc), wa)
+        } else {
+            ClPath::Helix(*arc, *a, *b, PreparedArc::new(&plane_arc))
         }
     }
 
     /// Distance from `p` (exact; a helix's within 1e-9).
     fn distance(&self, p: &P3) -> f64 {
         match self {
-            ClPath::Line(a, b) => point_segment(p, a, b),
             ClPath::Planar(plane, arc, w) => {
                 let (q, pw) = plane.split(p);
                 arc.distance(&q).hypot(pw - w)
@@ -161,6 +154,45 @@ impl ClPath {
         match self {
             ClPath::Helix(arc, _, _, prepared) => prepared.distance(&arc.plane.split(p).0),
             _ => self.distance(p),
+        }
+    }
+}
+
+/// The CL path of every segment, ready for many distances: lines straight from the rows, arcs
+/// prepared once and boxed, so that a line costs one pointer (a `ClPath` each took 168 bytes a
+/// segment: 15 MB of the 10× mould stream's read-back check).
+struct Paths<'a> {
+    cl: &'a [Cl],
+    segs: &'a [(usize, usize)],
+    curved: Vec<Option<Box<ClPath>>>,
+}
+
+impl<'a> Paths<'a> {
+    fn new(cl: &'a [Cl], segs: &'a [(usize, usize)]) -> Paths<'a> {
+        let curved = segs
+            .par_iter()
+            .map(|&(a, b)| cl[b].arc.as_ref().map(|arc| Box::new(ClPath::of(arc, &cl[a].tip, &cl[b].tip))))
+            .collect();
+        Paths { cl, segs, curved }
+    }
+
+    fn len(&self) -> usize {
+        self.curved.len()
+    }
+
+    /// Distance of segment `k` from `p` ([`ClPath::distance`]).
+    fn distance(&self, k: usize, p: &P3) -> f64 {
+        match &self.curved[k] {
+            Some(c) => c.distance(p),
+            None => point_segment(p, &self.cl[self.segs[k].0].tip, &self.cl[self.segs[k].1].tip),
+        }
+    }
+
+    /// A lower bound of [`Paths::distance`] ([`ClPath::lower_bound`]).
+    fn lower_bound(&self, k: usize, p: &P3) -> f64 {
+        match &self.curved[k] {
+            Some(c) => c.lower_bound(p),
+            None => self.distance(k, p),
         }
     }
 }
@@ -210,25 +242,25 @@ pub struct Deviation {
 }
 
 /// Index of the segment of `segs` (pairs of CL indices) nearest `p`, searched near `hint` first.
-fn nearest(p: &P3, paths: &[ClPath], segs: &[(usize, usize)], hint: usize, far: f64) -> (usize, f64) {
+fn nearest(p: &P3, paths: &Paths, hint: usize, far: f64) -> (usize, f64) {
     let lo = hint.saturating_sub(2);
-    let hi = (hint + 16).min(segs.len());
-    let mut best = (hint.min(segs.len().saturating_sub(1)), f64::INFINITY);
-    for (k, path) in paths.iter().enumerate().take(hi).skip(lo) {
-        if path.lower_bound(p) >= best.1 {
+    let hi = (hint + 16).min(paths.len());
+    let mut best = (hint.min(paths.len().saturating_sub(1)), f64::INFINITY);
+    for k in lo..hi {
+        if paths.lower_bound(k, p) >= best.1 {
             continue;
         }
-        let d = path.distance(p);
+        let d = paths.distance(k, p);
         if d < best.1 {
             best = (k, d);
         }
     }
     if best.1 > far {
-        for (k, path) in paths.iter().enumerate() {
-            if path.lower_bound(p) >= best.1 {
+        for k in 0..paths.len() {
+            if paths.lower_bound(k, p) >= best.1 {
                 continue;
             }
-            let d = path.distance(p);
+            let d = paths.distance(k, p);
             if d < best.1 {
                 best = (k, d);
             }
@@ -261,7 +293,7 @@ pub const CHUNK: usize = 8192;
 pub fn verify(cl: &[Cl], poses: &[Option<NcPose>], r: &Reading, samples_per_block: usize, tol: f64) -> Deviation {
     let far = tol;
     let segs: Vec<(usize, usize)> = (1..cl.len()).filter(|&i| !cl[i].rapid).map(|i| (i - 1, i)).collect();
-    let paths: Vec<ClPath> = segs.par_iter().map(|&(a, b)| ClPath::of(&cl[a], &cl[b])).collect();
+    let paths = Paths::new(cl, &segs);
     // Feed blocks as (start, end) poses in program order; a G53 block or an unknown position
     // breaks the chain.
     let mut blocks: Vec<(&NcPose, &NcPose)> = Vec::with_capacity(poses.len());
@@ -399,7 +431,7 @@ fn axis_deviation(
     axis: &V3,
     cl: &[Cl],
     segs: &[(usize, usize)],
-    paths: &[ClPath],
+    paths: &Paths,
     (seg, d): (usize, f64),
     from: Option<usize>,
     tol: f64,
@@ -412,7 +444,7 @@ fn axis_deviation(
         let (lo, hi) = ((u - half).max(0.0), (u + half).min(1.0));
         vector_arc(axis, &slerp(&cl[a].axis, &cl[b].axis, lo), &slerp(&cl[a].axis, &cl[b].axis, hi))
     };
-    let near = |k: usize| Some(paths[k].distance(tip)).filter(|&dk| dk <= tol);
+    let near = |k: usize| Some(paths.distance(k, tip)).filter(|&dk| dk <= tol);
     let mut best = (at(seg, d), seg);
     let mut take = |k: usize, dk: f64| {
         let a = at(k, dk);
@@ -452,7 +484,7 @@ fn axis_deviation(
 fn check_blocks(
     cl: &[Cl],
     segs: &[(usize, usize)],
-    paths: &[ClPath],
+    paths: &Paths,
     blocks: &[(&NcPose, &NcPose)],
     mut hint: Option<usize>,
     r: &Reading,
@@ -471,8 +503,8 @@ fn check_blocks(
             let (tip, axis) = r.at(&q);
             // Without a hint (a chunk but the first), a full search (a negative `far`).
             let (seg, d) = match hint {
-                Some(h) => nearest(&tip, paths, segs, h, far),
-                None => nearest(&tip, paths, segs, 0, -1.0),
+                Some(h) => nearest(&tip, paths, h, far),
+                None => nearest(&tip, paths, 0, -1.0),
             };
             hint = Some(seg);
             dev.samples += 1;

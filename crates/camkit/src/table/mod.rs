@@ -8,7 +8,7 @@ mod read;
 mod write;
 
 pub use columns::{COLUMNS, Col, ColumnSpec};
-pub use read::{read, read_each};
+pub use read::{read, read_each, read_each_source};
 pub use write::{RowWriter, WriteOptions, write};
 
 use crate::geom::{P2, P3, Plane, V3};

@@ -4,8 +4,12 @@
 use super::{Col, Field, Move, Row, Schema, Table, columns};
 use crate::error::{Error, Location, Result};
 use crate::geom::{P2, P3, Plane, V3};
-use crate::io::Input;
+use crate::io::{Input, Source};
 use crate::num::parse_finite;
+use std::cell::RefCell;
+use std::collections::VecDeque;
+use std::io::{BufRead, Read};
+use std::rc::Rc;
 
 /// Where each typed column sits in a record (field index), if present.
 struct Layout {
@@ -32,23 +36,53 @@ pub fn read(input: &Input, required: &[Col]) -> Result<Table> {
 /// Reads `input` row by row, handing each row to `on_row` as it is parsed (with the schema), so
 /// that a filter working run by run need not hold the table's rows; returns the schema. An error
 /// of `on_row` stops the reading and is returned.
-pub fn read_each(
-    input: &Input,
+pub fn read_each(input: &Input, required: &[Col], on_row: impl FnMut(&Schema, Row) -> Result<()>) -> Result<Schema> {
+    let data = normalise(&input.data);
+    let reader = csv_reader(&data[..]);
+    each_record(reader, &input.name, &mut LineCounter { data: &data, byte: 0, line: 1 }, required, on_row)
+}
+
+/// [`read_each`] from a [`Source`] read as a stream: never the input's text held whole, only the
+/// line at hand and what the csv reader buffers. The same rows, and the same errors at the same
+/// lines, as [`read_each`] reads from the whole text.
+pub fn read_each_source(
+    source: &Source,
+    required: &[Col],
+    on_row: impl FnMut(&Schema, Row) -> Result<()>,
+) -> Result<Schema> {
+    let lines = Rc::new(RefCell::new(LineStarts::default()));
+    let text = Normalising {
+        inner: source.reader()?,
+        out: Vec::new(),
+        at: 0,
+        emitted: 0,
+        ends_line: false,
+        lines: lines.clone(),
+    };
+    each_record(csv_reader(text), &source.name, &mut StreamLines { lines, line: 1 }, required, on_row)
+}
+
+fn csv_reader<R: Read>(r: R) -> csv::Reader<R> {
+    csv::ReaderBuilder::new().comment(Some(b'#')).trim(csv::Trim::All).flexible(false).from_reader(r)
+}
+
+/// The header and every record of `reader` (normalised text), lines counted by `lines`.
+fn each_record<R: Read>(
+    mut reader: csv::Reader<R>,
+    name: &str,
+    lines: &mut dyn LineAt,
     required: &[Col],
     mut on_row: impl FnMut(&Schema, Row) -> Result<()>,
 ) -> Result<Schema> {
-    let data = normalise(&input.data);
-    let mut reader =
-        csv::ReaderBuilder::new().comment(Some(b'#')).trim(csv::Trim::All).flexible(false).from_reader(&data[..]);
-    let loc = |line: u64| Location::file(&input.name).line(line);
-    let mut lines = LineCounter { data: &data, byte: 0, line: 1 };
-    let header = reader.byte_headers().map_err(|e| csv_error(e, &input.name, &mut lines))?.clone();
+    let loc = |line: u64| Location::file(name).line(line);
+    let header = reader.byte_headers().map_err(|e| csv_error(e, name, lines))?.clone();
     if header.is_empty() || header.iter().all(|h| h.is_empty()) {
-        return Err(Error::input("empty input: expected a header row naming the columns (e.g. x,y,z)")
-            .at(Location::file(&input.name)));
+        return Err(
+            Error::input("empty input: expected a header row naming the columns (e.g. x,y,z)").at(Location::file(name))
+        );
     }
     let header_line = header.position().map_or(1, |p| lines.at(p.byte()));
-    let (schema, layout) = parse_header(&header, &input.name, header_line)?;
+    let (schema, layout) = parse_header(&header, name, header_line)?;
     for &col in required {
         if !schema.has(col) {
             return Err(Error::input(format!("missing column `{}`", columns::spec(col).name)).at(loc(header_line)));
@@ -59,12 +93,123 @@ pub fn read_each(
         match reader.read_byte_record(&mut record) {
             Ok(true) => {}
             Ok(false) => break,
-            Err(e) => return Err(csv_error(e, &input.name, &mut lines)),
+            Err(e) => return Err(csv_error(e, name, lines)),
         }
         let line = record.position().map_or(0, |p| lines.at(p.byte()));
-        on_row(&schema, parse_row(&record, &layout, &schema, &input.name, line)?)?;
+        on_row(&schema, parse_row(&record, &layout, &schema, name, line)?)?;
     }
     Ok(schema)
+}
+
+/// Lines of the normalised text seen so far by a [`Normalising`] reader and not yet passed by
+/// the line count: (start offset, first byte; none for the empty line after a last LF), and
+/// where the text ended if it has.
+#[derive(Default)]
+struct LineStarts {
+    starts: VecDeque<(u64, Option<u8>)>,
+    end: Option<u64>,
+}
+
+/// The input normalised as [`normalise`] does, line by line as it is read, recording where each
+/// line starts for [`StreamLines`].
+struct Normalising<R> {
+    inner: R,
+    out: Vec<u8>,
+    at: usize,
+    emitted: u64,
+    ends_line: bool,
+    lines: Rc<RefCell<LineStarts>>,
+}
+
+impl<R: BufRead> Normalising<R> {
+    /// Reads the next input line (to LF or the end) into `out`, normalised; false at the end.
+    fn refill(&mut self) -> std::io::Result<bool> {
+        self.out.clear();
+        self.at = 0;
+        if self.inner.read_until(b'\n', &mut self.out)? == 0 {
+            let mut lines = self.lines.borrow_mut();
+            if self.ends_line {
+                lines.starts.push_back((self.emitted, None));
+            }
+            lines.end = Some(self.emitted);
+            return Ok(false);
+        }
+        let n = self.out.len();
+        // A CR is lone unless the LF closing this line follows it.
+        for k in 0..n {
+            if self.out[k] == b'\r' && !(k + 1 < n && self.out[k + 1] == b'\n') {
+                self.out[k] = b'\n';
+            }
+        }
+        let mut lines = self.lines.borrow_mut();
+        let mut start = 0;
+        while start < n {
+            let rest = &self.out[start..];
+            let blanks = rest.iter().take_while(|b| matches!(b, b' ' | b'\t')).count();
+            // A line of only spaces and tabs ends at a line break or at the input's end (the
+            // last line read has no LF only there).
+            if blanks > 0 && matches!(rest.get(blanks), None | Some(b'\n' | b'\r')) {
+                self.out[start] = b'#';
+            }
+            lines.starts.push_back((self.emitted + start as u64, Some(self.out[start])));
+            start = memchr::memchr(b'\n', &self.out[start..]).map_or(n, |k| start + k + 1);
+        }
+        self.emitted += n as u64;
+        self.ends_line = self.out[n - 1] == b'\n';
+        Ok(true)
+    }
+}
+
+impl<R: BufRead> Read for Normalising<R> {
+    fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
+        if self.at == self.out.len() && !self.refill()? {
+            return Ok(0);
+        }
+        let n = buf.len().min(self.out.len() - self.at);
+        buf[..n].copy_from_slice(&self.out[self.at..self.at + n]);
+        self.at += n;
+        Ok(n)
+    }
+}
+
+/// 1-based line of the record the csv reader says starts at a byte offset: that offset may point
+/// at comment or blank lines it skipped first. Offsets must not decrease between calls.
+trait LineAt {
+    fn at(&mut self, byte: u64) -> u64;
+}
+
+/// [`LineAt`] over the line starts a [`Normalising`] reader records: the lines before the
+/// offset are dropped as they are counted.
+struct StreamLines {
+    lines: Rc<RefCell<LineStarts>>,
+    line: u64,
+}
+
+impl LineAt for StreamLines {
+    fn at(&mut self, byte: u64) -> u64 {
+        let mut lines = self.lines.borrow_mut();
+        let LineStarts { starts, end } = &mut *lines;
+        // The line holding `byte`.
+        let mut byte = byte.min(end.unwrap_or(u64::MAX));
+        while let Some(&(start, _)) = starts.get(1)
+            && start <= byte
+        {
+            starts.pop_front();
+            self.line += 1;
+        }
+        // Comment and blank lines the reader skipped, and the LF of a CRLF (the reader ends a
+        // record at its CR): a line that ends at an LF has the next line's start after it.
+        while let (Some(&(start, first)), Some(&(next, _))) = (starts.front(), starts.get(1)) {
+            let blank = start == byte && matches!(first, Some(b'#' | b'\n' | b'\r'));
+            if !blank && byte + 1 != next {
+                break;
+            }
+            starts.pop_front();
+            self.line += 1;
+            byte = next;
+        }
+        self.line
+    }
 }
 
 /// The text with old Mac line ends (a lone CR) made LF and lines of only spaces and tabs made
@@ -98,9 +243,7 @@ struct LineCounter<'a> {
     line: u64,
 }
 
-impl LineCounter<'_> {
-    /// 1-based line of the record the csv reader says starts at `byte`: that offset may point
-    /// at comment or blank lines it skipped first. Offsets must not decrease between calls.
+impl LineAt for LineCounter<'_> {
     fn at(&mut self, byte: u64) -> u64 {
         let mut byte = (byte as usize).min(self.data.len());
         while matches!(self.data.get(byte), Some(b'#' | b'\n' | b'\r')) {
@@ -113,7 +256,7 @@ impl LineCounter<'_> {
     }
 }
 
-fn csv_error(e: csv::Error, file: &str, lines: &mut LineCounter) -> Error {
+fn csv_error(e: csv::Error, file: &str, lines: &mut dyn LineAt) -> Error {
     let line = e.position().map(|p| lines.at(p.byte()));
     let message = match e.kind() {
         csv::ErrorKind::UnequalLengths { expected_len, len, .. } => {
@@ -362,6 +505,59 @@ mod tests {
         assert_eq!(e.to_string(), "in.csv:3: expected 2 fields like the header, found 1");
         let t = read(&input("\u{feff}x,y\n1,2\n"), &[Col::X, Col::Y]).unwrap();
         assert_eq!(t.rows[0].pos.y, 2.0);
+    }
+
+    /// Rows read as (position, line), or the error.
+    type Rows = Result<Vec<(P3, u64)>>;
+
+    /// The whole text read and the text streamed from a file: the same rows at the same lines,
+    /// or the same error.
+    fn both(text: &[u8]) -> (Rows, Rows) {
+        let mut file = tempfile::NamedTempFile::new().unwrap();
+        std::io::Write::write_all(&mut file, text).unwrap();
+        let name = file.path().to_str().unwrap().to_string();
+        let rows = |rows: &mut Vec<(P3, u64)>, row: Row| rows.push((row.pos, row.line));
+        let mut whole = Vec::new();
+        let whole = read_each(&Input { name: name.clone(), data: text.to_vec() }, &[Col::X], |_, r| {
+            rows(&mut whole, r);
+            Ok(())
+        })
+        .map(|_| whole);
+        let mut streamed = Vec::new();
+        let streamed = read_each_source(&Source::open(&name).unwrap(), &[Col::X], |_, r| {
+            rows(&mut streamed, r);
+            Ok(())
+        })
+        .map(|_| streamed);
+        (whole, streamed)
+    }
+
+    proptest::proptest! {
+        #![proptest_config(proptest::prelude::ProptestConfig { cases: 400, ..Default::default() })]
+
+        /// Streamed from a file, a table reads as it does whole: comments, blank lines of spaces,
+        /// lone CRs, CRLF, a missing last LF, short and long records, bad numbers.
+        #[test]
+        fn streamed_reads_as_whole(pieces in proptest::collection::vec(0usize..14, 0..24), header in 0usize..3) {
+            const PIECES: [&str; 14] =
+                ["1,2", "3,4", "1", "1,2,3", "a,b", "# c,d", "  ", "\t", "\n", "\r", "\r\n", "\n", "\n", "\"5\",6"];
+            let mut text = ["x,y\n", "# h\r\nx,y\r\n", "  \nx,y\r"][header].to_string();
+            text.extend(pieces.iter().map(|&k| PIECES[k]));
+            let (whole, streamed) = both(text.as_bytes());
+            match (whole, streamed) {
+                (Ok(a), Ok(b)) => proptest::prop_assert_eq!(a, b, "{:?}", text),
+                (Err(a), Err(b)) => proptest::prop_assert_eq!(a.to_string(), b.to_string(), "{:?}", text),
+                (a, b) => proptest::prop_assert!(false, "{:?}: whole {:?}, streamed {:?}", text, a, b),
+            }
+        }
+    }
+
+    #[test]
+    fn streamed_empty_and_bom() {
+        for text in [&b""[..], b"\n\n", b"\xef\xbb\xbfx,y\n1,2", b"x,y\n1,\xff\n", b"x,y\n# end"] {
+            let (a, b) = both(text);
+            assert_eq!(format!("{a:?}"), format!("{b:?}"), "{text:?}");
+        }
     }
 
     #[test]
