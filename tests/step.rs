@@ -187,6 +187,46 @@ fn bad_step_input_is_refused_with_one_line() {
     assert_eq!(o.stderr.trim_end().lines().count(), 1, "{}", o.stderr);
 }
 
+/// Issue 20, found by the STEP family of scripts/fuzz-parsers.py on mutants of bspline.step: a
+/// B-spline curve cut short (a panic), a coordinate of 1e12 mm (searches without end), and a
+/// control point of the surface moved 20 mm so that its edge no longer lies on it (46 s, then the
+/// coverage check failed): each one line naming file, line and entity, exit 2, no output.
+#[test]
+fn broken_step_geometry_is_refused_with_one_line() {
+    let w = Work::new();
+    let run = |file: &str| w.run(BIN, &[file, "-r", "3", "--pick", "10", "-o", "out.csv", "-q"], b"");
+    let good = std::fs::read_to_string(data("step/bspline.step")).unwrap();
+    let line = |key: &str| good.lines().position(|l| l.starts_with(key)).unwrap() + 1;
+    let cases = [
+        (
+            ".UNSPECIFIED.,.F.\n  ,.F.,(4,4),(0.,1.),.PIECEWISE_BEZIER_KNOTS.);",
+            ".F.);",
+            "#27",
+            "#27: parameter 1 should be a list",
+        ),
+        (
+            "#35 = CARTESIAN_POINT('',(0.,13.5,2.))",
+            "#35 = CARTESIAN_POINT('',(0.,1e12,2.))",
+            "#35",
+            "#35: 1e12 mm is beyond ±1e9 mm",
+        ),
+        (
+            "#35 = CARTESIAN_POINT('',(0.,13.5,2.))",
+            "#35 = CARTESIAN_POINT('',(0.,33.5,2.))",
+            "#17",
+            "#17: edge 1 of the face lies",
+        ),
+    ];
+    for (from, to, at, want) in cases {
+        let bad = good.replacen(from, to, 1);
+        assert_ne!(bad, good, "{from}");
+        w.write("b.step", &bad);
+        let o = run("b.step");
+        o.fails(2, &format!("b.step:{}: {want}", line(at)));
+        assert!(!w.exists("out.csv"));
+    }
+}
+
 /// tool-attitude with --model on the STEP block: the ball end mill on the CL of the dish is
 /// clear (no row deeper than the gouge tolerance, the deepest within the faces' triangles' chord),
 /// and a contact moved 0.1 mm down is found gouging by 0.1·n_z (the normal's z), within the chord.

@@ -925,6 +925,23 @@ impl Face {
         }
     }
 
+    /// The farthest any point of the face's edges (at their loop samples) lies from its carrier,
+    /// with the edge's index (in loop order): a CAD file's edges lie on their faces within its
+    /// tolerance.
+    pub fn edges_off(&self) -> (f64, usize) {
+        let straight = matches!(self.carrier, Carrier::Analytic(Analytic::Plane { .. } | Analytic::Cylinder { .. }));
+        let mut worst = (0.0, 0);
+        for (k, (curve, _)) in self.edges.iter().enumerate() {
+            for p in curve.samples(straight, f64::INFINITY) {
+                let d = self.carrier.foot(&p, f64::INFINITY).map_or(f64::INFINITY, |(f, _, _)| (f.point - p).norm());
+                if !(d <= worst.0) {
+                    worst = (d, k);
+                }
+            }
+        }
+        worst
+    }
+
     /// The nearest point of the face to `q` no farther than `bound`, the carrier's normal there
     /// and whether the iterations converged.
     pub fn nearest(&self, q: &P3, bound: f64) -> Option<(Foot, bool)> {

@@ -18,6 +18,7 @@ use crate::doc::model::MAX_DEGREE;
 use crate::error::{Error, Location, Result};
 use crate::geom::{P3, V3};
 use crate::io::Input;
+use crate::tol::COORD_LIMIT;
 use nalgebra::{Isometry3, Matrix3, Rotation3, Translation3, UnitQuaternion};
 use std::collections::HashMap;
 use std::f64::consts::TAU;
@@ -30,6 +31,14 @@ const CURVES: &str = "LINE, CIRCLE, ELLIPSE, B_SPLINE_CURVE_WITH_KNOTS (also as 
 
 /// Parameter length of the ellipse spline of [`ellipse_from`]: four quarter arcs.
 const ELLIPSE_DOMAIN: f64 = 4.0;
+
+/// Farthest (mm) a face's edges may lie from its surface: CAD systems write them within their
+/// tolerance, 1e-7 to 1e-3 mm (the files in data/step within 1e-9); ten times the loosest.
+const EDGE_FIT: f64 = 0.01;
+
+/// Most knots a B-spline curve or surface direction may have: a million, far beyond CAD files
+/// (a knot vector is as long as the control points and the degree), short of memory trouble.
+const MAX_KNOTS: f64 = 1e6;
 
 /// The ellipse `centre + x cos θ + y sin θ` (`x`, `y` its semi-axes as vectors) as an exact
 /// rational quadratic spline of four quarter arcs (the affine image of the NURBS circle), starting
@@ -286,7 +295,18 @@ impl Reader<'_> {
         if c.len() != 3 {
             return Err(self.invalid(id, "a 3-D point needs three coordinates"));
         }
-        Ok(P3::new(c[0], c[1], c[2]) * self.mm)
+        let q = P3::new(c[0], c[1], c[2]) * self.mm;
+        self.within_limit(id, q.coords.amax())?;
+        Ok(q)
+    }
+
+    /// Refuses a coordinate or length beyond ±[`COORD_LIMIT`] mm, as every table does: there the
+    /// micrometre tolerances fall below the floating-point resolution.
+    fn within_limit(&self, id: usize, v: f64) -> Res<()> {
+        if v.abs() <= COORD_LIMIT {
+            return Ok(());
+        }
+        Err(self.invalid(id, format!("{v:e} mm is beyond ±{COORD_LIMIT:e} mm, where the micrometre tolerances fall below the floating-point resolution")))
     }
 
     /// A DIRECTION, unit.
@@ -433,6 +453,15 @@ impl Reader<'_> {
             Carrier::Revolution(_) => "revolution",
         };
         let face = Face::new(carrier, loops, same_sense);
+        // Edges far off their surface are a broken file (a moved control point, a wrong vertex):
+        // traced, it gives gaps and endless searches, never the part.
+        let (off, edge) = face.edges_off();
+        if !(off <= EDGE_FIT) {
+            return Err(self.invalid(
+                id,
+                format!("edge {} of the face lies {off:.3e} mm off its surface (more than {EDGE_FIT} mm): the face's edges and surface do not fit together", edge + 1),
+            ));
+        }
         Ok(Surface::new(format!("{kind}#{id}"), Geometry::Face(Box::new(face)), placement, same_sense == reversed))
     }
 
@@ -487,6 +516,7 @@ impl Reader<'_> {
     /// A positive length parameter in mm.
     fn length(&self, id: usize, p: &[Param], i: usize) -> Res<f64> {
         let v = self.num(id, p, i)? * self.mm;
+        self.within_limit(id, v)?;
         if v > 0.0 { Ok(v) } else { Err(self.invalid(id, format!("parameter {} must be a positive length", i + 1))) }
     }
 
@@ -552,6 +582,10 @@ impl Reader<'_> {
         if m.len() != v.len() || m.iter().any(|x| *x < 1.0 || x.fract() != 0.0) {
             return Err(self.invalid(id, "knot multiplicities and knots must pair up"));
         }
+        // A knot vector is one knot more than control points and degree together: far fewer.
+        if m.iter().sum::<f64>() > MAX_KNOTS {
+            return Err(self.invalid(id, format!("more than {MAX_KNOTS:e} knots")));
+        }
         Ok(v.iter().zip(&m).flat_map(|(k, n)| std::iter::repeat_n(*k, *n as usize)).collect())
     }
 
@@ -562,7 +596,7 @@ impl Reader<'_> {
             Some(h) => (h, self.part(id, "B_SPLINE_CURVE_WITH_KNOTS")?),
             None => {
                 let p = self.part(id, "B_SPLINE_CURVE_WITH_KNOTS")?;
-                (&p[1..], &p[6..])
+                (p.get(1..).unwrap_or_default(), p.get(6..).unwrap_or_default())
             }
         };
         let degree = self.num(id, head, 0)?;
@@ -593,7 +627,7 @@ impl Reader<'_> {
             Some(h) => (h, self.part(id, "B_SPLINE_SURFACE_WITH_KNOTS")?),
             None => {
                 let p = self.part(id, "B_SPLINE_SURFACE_WITH_KNOTS")?;
-                (&p[1..], &p[8..])
+                (p.get(1..).unwrap_or_default(), p.get(8..).unwrap_or_default())
             }
         };
         let degree = [self.num(id, head, 0)?, self.num(id, head, 1)?];
