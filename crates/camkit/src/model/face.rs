@@ -795,7 +795,7 @@ impl Face {
     /// face are kept; the boundary is a polygon through points of the edges, each of its sides
     /// within 3/4 of `chord` of its edge.
     pub fn triangles(&self, chord: f64) -> (Vec<[P3; 3]>, f64) {
-        use spade::{ConstrainedDelaunayTriangulation, Point2, Triangulation};
+        use spade::{ConstrainedDelaunayTriangulation, HierarchyHintGenerator, Point2, Triangulation};
         // A triangle's distance from a smooth surface is, to second order, a quadratic vanishing at
         // its corners: 4 Σ m_ij λi λj over the edges' middles m_ij, at most 4/3 of the largest
         // middle. Refining to 3/4 of the chord keeps the triangles within the chord.
@@ -806,7 +806,9 @@ impl Face {
         let extent = (hi[0] - lo[0]) * (hi[1] - lo[1]);
         let at = |q: [f64; 2]| self.carrier.point(q);
         let middle = |a: [f64; 2], b: [f64; 2]| [(a[0] + b[0]) / 2.0, (a[1] + b[1]) / 2.0];
-        let mut cdt = ConstrainedDelaunayTriangulation::<Point2<f64>>::new();
+        // Located through spade's hierarchy: the refinement's probes come in face order, far from
+        // the last vertex, and on a long thin face walking from it made the insertions quadratic.
+        let mut cdt = ConstrainedDelaunayTriangulation::<Point2<f64>, (), (), (), HierarchyHintGenerator<f64>>::new();
         // A start grid as fine each way as the surface bends that way (a cylinder's straight
         // lines need no points along them): steps halved from 1/16 of the span until the surface
         // midway between two grid points of nine lines across is within the chord of their chord.
