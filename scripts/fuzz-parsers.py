@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Mutation fuzzing of every parser family (issue 20): tables (CSV), G-code, JSON documents
-(tool, machine, setup, model, frame), STL (binary and ASCII) and DXF. Each run takes a seed file
-of the family, mutates it (bit flips, cut/duplicated/spliced chunks, numbers replaced by
+(tool, machine, setup, model, frame), STL (binary and ASCII), DXF, SVG and STEP. Each run takes a
+seed file of the family, mutates it (bit flips, cut/duplicated/spliced chunks, numbers replaced by
 extremes, control characters, BOMs, truncation, swapped lines) and feeds it to every filter that
 reads that family. A run keeps its promises when it exits 0, 1 or 2 within 20 s of CPU under 4 GiB,
 with no panic ("internal error") and, when it fails, one error line (warnings aside).
@@ -23,8 +23,13 @@ DATA = os.path.join(ROOT, "data")
 SQUARE = "path,move,x,y,z\n1,rapid,0,0,0\n1,line,60,0,0\n1,line,60,40,0\n1,line,0,40,0\n1,line,0,0,0\n"
 ISLAND = SQUARE + "2,rapid,24,16,0\n2,line,24,24,0\n2,line,36,24,0\n2,line,36,16,0\n2,line,24,16,0\n"
 ARCS = "path,move,x,y,z,xc,yc\n1,rapid,15,0,0,,\n1,ccw,-15,0,0,0,0\n1,ccw,15,0,0,0,0\n"
-CL = "path,move,x,y,z,i,j,k,f\n" + "".join(
-    f"1,{'rapid' if k == 0 else 'line'},{k * 0.5},{(k % 5) * 0.3},{15 + (k % 3) * 0.1},0,0,1,600\n" for k in range(40))
+def cl(z):
+    """A CL table of 40 rows at heights z … z + 0.2 over x 0 … 19.5."""
+    return "path,move,x,y,z,i,j,k,f\n" + "".join(
+        f"1,{'rapid' if k == 0 else 'line'},{k * 0.5},{(k % 5) * 0.3},{z + (k % 3) * 0.1},0,0,1,600\n" for k in range(40))
+
+
+CL = cl(15)
 GCODE = "G21 G90\nG0 X0 Y0 Z-1\nG1 X0.1 F300\n" + "".join(
     f"G1 X{k * 0.7:.3f} Y{(k % 9) * 0.4:.3f}\n" for k in range(60)) + "G1 X40 Y0\nG2 X50 Y0 I5 J0\nG3 X40 Y0 R5\nM30\n"
 SQUARE_NC = "G21 G90\nG0 X0 Y0 Z-1\nG1 X60 F300\nG1 Y40\nG3 X50 Y50 I-10 J0\nG1 X0\nG1 Y0\nM30\n"
@@ -111,6 +116,18 @@ def families():
                  "islands.dxf": read("post-6axis/pocket-islands.dxf")}, [
             ("medial-trochoid", ["{in}", "--radius", "4", "--sample", "2"]),
             ("offset", ["{in}", "--radius", "2", "--side", "left"]),
+        ]),
+        "svg": ({"pocket.svg": read("contours/pocket.svg"), "inkscape.svg": read("contours/inkscape.svg")}, [
+            ("medial-trochoid", ["{in}", "--radius", "3", "--sample", "2"]),
+            ("offset", ["{in}", "--radius", "2", "--side", "left"]),
+            ("offset", ["{in}", "--radius", "2", "--until-empty"]),
+        ]),
+        "step": ({"faces.step": read("step/faces.step"), "bspline.step": read("step/bspline.step"),
+                  "revolve.step": read("step/revolve.step")}, [
+            ("stylus-trace", ["{in}", "--tool", "tool.json", "--pick", "6", "--max-step", "3"]),
+            ("stylus-trace", ["{in}", "-r", "3", "--pick", "10", "--region=-20,20,-20,20"]),
+            # Above the models, and a coarser solid: the gouge check's tessellation is not the parser.
+            ("tool-attitude", ["high.csv", "--tool", "tool.json", "--axis", "0,0,1", "--model", "{in}", "--gouge-tol", "0.02"]),
         ]),
     }
 
@@ -208,7 +225,8 @@ def main():
     total_bad = 0
     with tempfile.TemporaryDirectory() as tmp:
         # Fixed companions the runs name: a CL table, a contour, a tool.
-        for name, text in (("cl.csv", CL), ("square.csv", SQUARE), ("tool.json", TOOL), ("part.csv", SQUARE)):
+        for name, text in (("cl.csv", CL), ("high.csv", cl(45)), ("square.csv", SQUARE),
+                           ("tool.json", TOOL), ("part.csv", SQUARE)):
             open(os.path.join(tmp, name), "w").write(text)
         for fam in chosen:
             seeds, runs = fams[fam]
