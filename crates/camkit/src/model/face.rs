@@ -936,7 +936,7 @@ impl Face {
         for (k, (curve, _)) in self.edges.iter().enumerate() {
             for p in curve.samples(straight, f64::INFINITY) {
                 let d = self.carrier.foot(&p, f64::INFINITY).map_or(f64::INFINITY, |(f, _, _)| (f.point - p).norm());
-                if !(d <= worst.0) {
+                if d > worst.0 || d.is_nan() {
                     worst = (d, k);
                 }
             }

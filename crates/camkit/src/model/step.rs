@@ -456,7 +456,7 @@ impl Reader<'_> {
         // Edges far off their surface are a broken file (a moved control point, a wrong vertex):
         // traced, it gives gaps and endless searches, never the part.
         let (off, edge) = face.edges_off();
-        if !(off <= EDGE_FIT) {
+        if off > EDGE_FIT || off.is_nan() {
             return Err(self.invalid(
                 id,
                 format!("edge {} of the face lies {off:.3e} mm off its surface (more than {EDGE_FIT} mm): the face's edges and surface do not fit together", edge + 1),
