@@ -188,9 +188,10 @@ fn bad_step_input_is_refused_with_one_line() {
 }
 
 /// Issue 20, found by the STEP family of scripts/fuzz-parsers.py on mutants of bspline.step: a
-/// B-spline curve cut short (a panic), a coordinate of 1e12 mm (searches without end), and a
+/// B-spline curve cut short (a panic), a coordinate of 1e12 mm (searches without end), a
 /// control point of the surface moved 20 mm so that its edge no longer lies on it (46 s, then the
-/// coverage check failed): each one line naming file, line and entity, exit 2, no output.
+/// coverage check failed), and a knot repeated a million times: each one line naming file, line
+/// and entity, exit 2, no output.
 #[test]
 fn broken_step_geometry_is_refused_with_one_line() {
     let w = Work::new();
@@ -216,6 +217,7 @@ fn broken_step_geometry_is_refused_with_one_line() {
             "#17",
             "#17: edge 1 of the face lies",
         ),
+        ("(4,1,4),(0.,1.,2.)", "(4,1000001,4),(0.,1.,2.)", "#65", "#65: more than 1e6 knots"),
     ];
     for (from, to, at, want) in cases {
         let bad = good.replacen(from, to, 1);

@@ -295,9 +295,7 @@ pub fn offset_contour(c: &Contour, d: f64, side: Side, opts: &OffsetOptions) -> 
     // A closed contour that crosses itself has no side that stays inside: its offset is what the
     // tool can cut on that side, loops and open stretches ending where they would gouge.
     let closed = c.closed && !(opts.self_crossing_input && c.self_crossing().is_some());
-    let direct = verified(&[c], d, side.sign(), closed, opts, |source, nudge, eps, index| {
-        contour_kernel(source[0], (d + nudge) * side.sign(), closed, eps, index, opts)
-    });
+    let direct = direct_runs(c, d, side, closed, opts);
     match direct {
         Err(e) if closed => {
             let set = SegSet::new([c]);
@@ -305,6 +303,14 @@ pub fn offset_contour(c: &Contour, d: f64, side: Side, opts: &OffsetOptions) -> 
         }
         _ => direct,
     }
+}
+
+/// [`offset_contour`]'s direct route: the kernel's runs on `c` itself over the epsilon ladder,
+/// each verified, none in two steps.
+fn direct_runs(c: &Contour, d: f64, side: Side, closed: bool, opts: &OffsetOptions) -> Result<Offset, OffsetError> {
+    verified(&[c], d, side.sign(), closed, opts, |source, nudge, eps, index| {
+        contour_kernel(source[0], (d + nudge) * side.sign(), closed, eps, index, opts)
+    })
 }
 
 /// Where the first step of [`in_two_steps`] stops, as fractions of the distance, in the order
@@ -957,7 +963,7 @@ mod tests {
         let (c, rho) = wiggle_bend(143_118, (2.4883864625834424, 3.0), (b, 52.0), 19, true, 0.005053368796153272);
         let r = rho * (1.0 - 0.010755669223625409);
         let opts = OffsetOptions::default();
-        assert!(direct(&c, r, Side::Left, &opts).is_err(), "every direct run fails");
+        assert!(direct_runs(&c, r, Side::Left, true, &opts).is_err(), "every direct run fails");
         let o = offset_contour(&c, r, Side::Left, &opts).unwrap_or_else(|e| panic!("{e}"));
         assert!(o.check.deviation() <= opts.tol && o.contours.len() == 1 && o.contours[0].closed);
         assert!(check_offset(&[&c], &o.contours, r, Side::Left, true, opts.tol).is_ok());
@@ -979,13 +985,6 @@ mod tests {
         Contour::polygon(&pts, true)
     }
 
-    /// [`offset_contour`]'s direct route alone: every run on the loop itself, none in two steps.
-    fn direct(c: &Contour, r: f64, side: Side, opts: &OffsetOptions) -> Result<Offset, OffsetError> {
-        verified(&[c], r, side.sign(), true, opts, |s, nudge, eps, index| {
-            contour_kernel(s[0], (r + nudge) * side.sign(), true, eps, index, opts)
-        })
-    }
-
     /// The `--wiggle` fuzz's seed 211 (issue 20, D13): 40 021 lines offset outward by R 1. Its
     /// troughs come within a hair of R, and every direct run (36) dropped whole slices between
     /// their fans or left the loop open there; in two steps (0.5 + 0.5) it verifies. Seeds 237
@@ -996,7 +995,7 @@ mod tests {
         let seed = (40021, 5.0, 134.0, 1.4525602618305642, 1.97589781332226, 5.8162058657568005, 0.9352413681531121);
         let c = fuzz_wiggle(seed);
         let opts = OffsetOptions::default();
-        let e = direct(&c, 1.0, Side::Right, &opts).expect_err("every direct run fails");
+        let e = direct_runs(&c, 1.0, Side::Right, true, &opts).expect_err("every direct run fails");
         assert!(matches!(e.defect, Defect::Open(_)), "{e}");
         let o = offset_contour(&c, 1.0, Side::Right, &opts).unwrap_or_else(|e| panic!("{e}"));
         assert_eq!((o.contours.len(), o.contours[0].closed), (1, true));

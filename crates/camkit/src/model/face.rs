@@ -1167,6 +1167,32 @@ mod tests {
         assert!(ok && (p - P3::new(10.0, 0.0, 0.0)).norm() < 1e-12, "{p}");
     }
 
+    /// A square face on the plane z = 0 with one edge lifted to z = h (and a spline edge, a
+    /// quarter circle, left on it): its edges lie exactly h off the surface, at the lifted edge.
+    #[test]
+    fn edges_off_is_the_lifted_edges_height() {
+        let plane = || Carrier::Analytic(Analytic::Plane { point: P3::origin(), normal: V3::z() });
+        let h = std::f64::consts::FRAC_1_SQRT_2;
+        let quarter = SplineCurve {
+            degree: 2,
+            ctrl: vec![P3::new(10.0, 0.0, 0.0), P3::new(10.0, 10.0, 0.0), P3::new(0.0, 10.0, 0.0)],
+            weights: Some(vec![1.0, h, 1.0]),
+            knots: vec![0.0, 0.0, 0.0, 1.0, 1.0, 1.0],
+        };
+        for lift in [0.0, 0.02, 3.5] {
+            let a = P3::new(0.0, 10.0, lift);
+            let edges = vec![
+                (Curve::Line { a: P3::origin(), b: P3::new(10.0, 0.0, 0.0) }, true),
+                (Curve::spline(quarter.clone(), 0.0, 1.0), true),
+                (Curve::Line { a: P3::new(0.0, 10.0, 0.0), b: a }, true),
+                (Curve::Line { a, b: P3::new(0.0, 0.0, lift) }, true),
+            ];
+            let (off, edge) = Face::new(plane(), vec![edges], true).edges_off();
+            assert!((off - lift).abs() < 1e-15, "{off} vs {lift}");
+            assert!(lift == 0.0 || edge >= 2, "{edge}");
+        }
+    }
+
     /// The point-only evaluation the nearest-point search samples with is the full evaluation's
     /// point to the bit (a rational cubic of three spans, at knots, inside spans and at the ends),
     /// so the search's samples and the outlines are what they were with the derivatives.
