@@ -16,6 +16,7 @@ use super::closed_form::{Extreme, Hollow};
 use crate::doc::tool::{Tool, ToolKind};
 use crate::geom::{P3, V3};
 use crate::model::analytic::Analytic;
+use crate::model::face::MAX_VERTICES;
 use crate::model::{Aabb, Geometry, Model};
 use parry3d_f64::bounding_volume::BoundingVolume;
 use parry3d_f64::math::{Pose, Vector};
@@ -473,6 +474,23 @@ impl Solid {
     }
 
     fn build(model: &Model, chord: f64, any: bool) -> Result<Solid, String> {
+        // Every face's triangulation estimated before any is built (its start grid), and the
+        // model refused past the bound: faces bent that finely take minutes and gigabytes.
+        let least: Vec<(usize, &str)> = model
+            .surfaces
+            .iter()
+            .filter_map(|s| match &s.geometry {
+                Geometry::Face(f) => Some((f.least_vertices(chord), s.name.as_str())),
+                _ => None,
+            })
+            .collect();
+        let total: usize = least.iter().map(|l| l.0).sum();
+        if total > MAX_VERTICES {
+            let (n, name) = least.iter().max().copied().unwrap_or_default();
+            return Err(format!(
+                "within {chord} mm the faces' triangles need at least {total} vertices (the largest, surface {name}, {n}), more than the {MAX_VERTICES} a model's may have: the faces are too large or too finely bent for the check"
+            ));
+        }
         let mut solid =
             Solid { pieces: Vec::new(), hollows: Vec::new(), rods: Vec::new(), chord: 0.0, open: Vec::new() };
         for s in &model.surfaces {
@@ -571,7 +589,7 @@ impl Solid {
                     )?)
                 }
                 Geometry::Face(f) => {
-                    let (tris, dev) = f.triangles(chord);
+                    let (tris, dev) = f.triangles(chord).map_err(|e| format!("surface {}: {e}", s.name))?;
                     let turned = tris.into_iter().map(|t| if s.flip { [t[0], t[2], t[1]] } else { t });
                     add((mesh_piece(&s.name, turned.map(|t| t.map(place)), false)?.0, dev))
                 }

@@ -230,6 +230,18 @@ impl Curve {
         Curve::Spline { curve, t0, t1, samples }
     }
 
+    /// The curve's first and last point, in its own parameter order.
+    pub fn ends(&self) -> (P3, P3) {
+        match self {
+            Curve::Line { a, b } => (*a, *b),
+            Curve::Arc { centre, x, y, radius, t0, t1 } => {
+                let at = |t: f64| centre + (x * t.cos() + y * t.sin()) * *radius;
+                (at(*t0), at(*t1))
+            }
+            Curve::Spline { curve, t0, t1, .. } => (curve.point(*t0), curve.point(*t1)),
+        }
+    }
+
     /// The exact (lines, arcs) or converged nearest point to `q`.
     pub fn nearest(&self, q: &P3) -> (P3, bool) {
         match self {
@@ -341,7 +353,28 @@ struct Loop {
     cells: Vec<Vec<u32>>,
 }
 
-/// Most vertices of one face's triangulation (some 200 bytes each while it is built).
+/// A vertex of a face's triangulation: its (u, v) scaled to lengths, and the surface's point there.
+#[derive(Clone, Copy, Debug)]
+struct Node {
+    at: spade::Point2<f64>,
+    p: P3,
+}
+
+impl spade::HasPosition for Node {
+    type Scalar = f64;
+    fn position(&self) -> spade::Point2<f64> {
+        self.at
+    }
+}
+
+/// A face's constrained Delaunay triangulation, located through spade's hierarchy (the
+/// refinement's probes come in face order, far from the last vertex, and on a long thin face
+/// walking from it made the insertions quadratic); a triangle's data is the largest distance its
+/// probes found, once none needed refining.
+type Cdt = spade::ConstrainedDelaunayTriangulation<Node, (), (), Option<f64>, spade::HierarchyHintGenerator<f64>>;
+
+/// Most vertices of one face's triangulation, and of a model's faces' start grids in all (some
+/// 200 bytes each while a face is built, 760 MB and 11 s of CPU for a face of a million).
 pub const MAX_VERTICES: usize = 2_000_000;
 
 /// Columns of u, and cells each way, per loop.
@@ -522,8 +555,8 @@ impl Carrier {
                 let rho = major + minor * v.cos();
                 P3::new(rho * u.cos(), rho * u.sin(), minor * v.sin())
             }
-            Carrier::Patch(s) => s.eval(u, v).s,
-            Carrier::Revolution(r) => r.eval(u, v).s,
+            Carrier::Patch(s) => s.point(u, v),
+            Carrier::Revolution(r) => r.point(u, v),
         }
     }
 
@@ -784,34 +817,14 @@ impl Face {
         (lo, hi)
     }
 
-    /// Triangles covering the face (face frame, turned so that their right-hand normals follow
-    /// the carrier's) and the largest distance found between them and the surface: a constrained
-    /// Delaunay triangulation (`spade`) in (u, v) of the loops (as constraints, each segment
-    /// halved until the surface at its middle is within `chord` of its chord) and a grid as fine
-    /// each way as the surface bends that way, refined where the surface bends: every kept triangle whose plane is farther than 3/4 of `chord`
-    /// from the surface at its edges' middles or its centroid gets a vertex at the worst of them,
-    /// until none does or [`MAX_VERTICES`] are reached; the distance returned is 4/3 of the largest
-    /// measured (to second order a triangle's distance is at most 4/3 of its edges' middles'). The triangles whose middle is inside the
-    /// face are kept; the boundary is a polygon through points of the edges, each of its sides
-    /// within 3/4 of `chord` of its edge.
-    pub fn triangles(&self, chord: f64) -> (Vec<[P3; 3]>, f64) {
-        use spade::{ConstrainedDelaunayTriangulation, HierarchyHintGenerator, Point2, Triangulation};
-        // A triangle's distance from a smooth surface is, to second order, a quadratic vanishing at
-        // its corners: 4 Σ m_ij λi λj over the edges' middles m_ij, at most 4/3 of the largest
-        // middle. Refining to 3/4 of the chord keeps the triangles within the chord.
+    /// The steps each way of a face's start grid within `chord`: as fine each way as the surface
+    /// bends that way (a cylinder's straight lines need no points along them), halved from 1/16
+    /// of the span until the surface midway between two grid points of nine lines across is
+    /// within 3/4 of the chord of their chord (at most 2¹² each way).
+    fn grid(&self, chord: f64) -> (usize, usize) {
         let target = 0.75 * chord;
-        // The loops through points of the edges within the target of them.
-        let fine = self.outlined(target);
         let (lo, hi) = self.span();
-        let extent = (hi[0] - lo[0]) * (hi[1] - lo[1]);
         let at = |q: [f64; 2]| self.carrier.point(q);
-        let middle = |a: [f64; 2], b: [f64; 2]| [(a[0] + b[0]) / 2.0, (a[1] + b[1]) / 2.0];
-        // Located through spade's hierarchy: the refinement's probes come in face order, far from
-        // the last vertex, and on a long thin face walking from it made the insertions quadratic.
-        let mut cdt = ConstrainedDelaunayTriangulation::<Point2<f64>, (), (), (), HierarchyHintGenerator<f64>>::new();
-        // A start grid as fine each way as the surface bends that way (a cylinder's straight
-        // lines need no points along them): steps halved from 1/16 of the span until the surface
-        // midway between two grid points of nine lines across is within the chord of their chord.
         let steps = |c: usize| {
             let mut n = 16usize;
             while n < 1 << 12 {
@@ -830,11 +843,92 @@ impl Face {
             }
             n
         };
-        let (nu, nv) = (steps(0), steps(1));
+        (steps(0), steps(1))
+    }
+
+    /// The fewest vertices [`Face::triangles`] makes within `chord`: its start grid's (a cheap
+    /// estimate to refuse a model by before tessellating any face).
+    pub fn least_vertices(&self, chord: f64) -> usize {
+        let (nu, nv) = self.grid(chord);
+        (nu + 1) * (nv + 1)
+    }
+
+    /// Lengths on the surface per unit of u and of v (the mean over a 9 × 9 grid of the span),
+    /// each rounded to a power of two (1 where the surface does not move that way).
+    fn uv_scale(&self, lo: [f64; 2], hi: [f64; 2]) -> [f64; 2] {
+        let at = |i: usize, j: usize| {
+            self.carrier.point([lo[0] + (hi[0] - lo[0]) * i as f64 / 8.0, lo[1] + (hi[1] - lo[1]) * j as f64 / 8.0])
+        };
+        let (mut du, mut dv) = (0.0, 0.0);
+        for i in 0..=8 {
+            for j in 0..8 {
+                du += (at(j + 1, i) - at(j, i)).norm();
+                dv += (at(i, j + 1) - at(i, j)).norm();
+            }
+        }
+        let pow2 = |len: f64, span: f64| {
+            let speed = len / span;
+            if speed.is_finite() && speed > 0.0 {
+                2f64.powi(speed.log2().round().clamp(-900.0, 900.0) as i32)
+            } else {
+                1.0
+            }
+        };
+        [pow2(du / 9.0, hi[0] - lo[0]), pow2(dv / 9.0, hi[1] - lo[1])]
+    }
+
+    /// Triangles covering the face (face frame, turned so that their right-hand normals follow
+    /// the carrier's) and the largest distance found between them and the surface: a constrained
+    /// Delaunay triangulation (`spade`) in (u, v) of the loops (as constraints, each segment
+    /// halved until the surface at its middle is within `chord` of its chord) and a grid as fine
+    /// each way as the surface bends that way, refined where the surface bends: every kept triangle whose plane is farther than 3/4 of `chord`
+    /// from the surface at its edges' middles or its centroid gets a vertex at the worst of them,
+    /// until none does or [`MAX_VERTICES`] are reached; the distance returned is 4/3 of the largest
+    /// measured (to second order a triangle's distance is at most 4/3 of its edges' middles'). The triangles whose middle is inside the
+    /// face are kept; the boundary is a polygon through points of the edges, each of its sides
+    /// within 3/4 of `chord` of its edge. Refused (the reason) where the start grid alone would
+    /// exceed [`MAX_VERTICES`].
+    pub fn triangles(&self, chord: f64) -> Result<(Vec<[P3; 3]>, f64), String> {
+        use spade::{Point2, Triangulation};
+        // A triangle's distance from a smooth surface is, to second order, a quadratic vanishing at
+        // its corners: 4 Σ m_ij λi λj over the edges' middles m_ij, at most 4/3 of the largest
+        // middle. Refining to 3/4 of the chord keeps the triangles within the chord.
+        let target = 0.75 * chord;
+        // The loops through points of the edges within the target of them.
+        let fine = self.outlined(target);
+        let (lo, hi) = self.span();
+        let extent = (hi[0] - lo[0]) * (hi[1] - lo[1]);
+        let at = |q: [f64; 2]| self.carrier.point(q);
+        let middle = |a: [f64; 2], b: [f64; 2]| [(a[0] + b[0]) / 2.0, (a[1] + b[1]) / 2.0];
+        // Triangulated in (u, v) scaled to the surface's lengths: a Delaunay triangulation is not
+        // invariant under stretching one axis, and a knot vector over (0, 1e9) or an angle
+        // beside a length makes its triangles needles that refinement never ends. Powers of two,
+        // so that the mapping is exact both ways.
+        let scale = self.uv_scale(lo, hi);
+        // spade refuses coordinates under 2^-142 but 0: those are 0 (far below any length here).
+        let flush = |x: f64| if x.abs() < spade::MIN_ALLOWED_VALUE { 0.0 } else { x };
+        let to = |q: [f64; 2]| Point2::new(flush(q[0] * scale[0]), flush(q[1] * scale[1]));
+        let back = |p: Point2<f64>| [p.x / scale[0], p.y / scale[1]];
+        let (nu, nv) = self.grid(chord);
+        // The start grid is the least the triangulation holds: past the bound, refuse before
+        // building it (a face bent that finely over its span: a 12 km spike on a patch).
+        let least = (nu + 1) * (nv + 1);
+        if least > MAX_VERTICES {
+            return Err(format!(
+                "within {chord} mm its triangles need at least {least} vertices ({} × {} along its (u, v) directions), more than the {MAX_VERTICES} a face may have: the face is too large or too finely bent for the check",
+                nu + 1,
+                nv + 1
+            ));
+        }
+        // The grid and the loops' points (constraint edges between neighbours), bulk-loaded: a
+        // grid's points are cocircular, and inserted one by one each legalised its neighbourhood.
+        let mut nodes: Vec<Node> = Vec::with_capacity(least);
+        let mut edges: Vec<[usize; 2]> = Vec::new();
+        let node = |q: [f64; 2]| Node { at: to(q), p: at(q) };
         for i in 0..=nu {
             for j in 0..=nv {
                 let f = [i as f64 / nu as f64, j as f64 / nv as f64];
-                cdt.insert(Point2::new(lo[0] + (hi[0] - lo[0]) * f[0], lo[1] + (hi[1] - lo[1]) * f[1])).ok();
+                nodes.push(node([lo[0] + (hi[0] - lo[0]) * f[0], lo[1] + (hi[1] - lo[1]) * f[1]]));
             }
         }
         for l in &fine.loops {
@@ -857,25 +951,44 @@ impl Face {
                     }
                     k *= 2;
                 }
-                let mut prev = cdt.insert(Point2::new(a[0], a[1])).ok();
+                nodes.push(node(a));
                 for i in 1..=k {
                     let t = i as f64 / k as f64;
-                    let next = cdt.insert(Point2::new(a[0] + (b[0] - a[0]) * t, a[1] + (b[1] - a[1]) * t)).ok();
-                    if let (Some(p), Some(q)) = (prev, next) {
-                        if p != q {
-                            cdt.try_add_constraint(p, q);
-                        }
+                    nodes.push(node([a[0] + (b[0] - a[0]) * t, a[1] + (b[1] - a[1]) * t]));
+                    let (p, q) = (nodes.len() - 2, nodes.len() - 1);
+                    if nodes[p].at != nodes[q].at {
+                        edges.push([p, q]);
                     }
-                    prev = next;
                 }
             }
         }
+        // Points spade cannot take (not finite) are left out, as an insertion's error would leave them.
+        let mut keep = vec![usize::MAX; nodes.len()];
+        let mut kept = Vec::with_capacity(nodes.len());
+        for (k, n) in nodes.into_iter().enumerate() {
+            if spade::validate_vertex(&n).is_ok() && n.p.coords.iter().all(|c| c.is_finite()) {
+                keep[k] = kept.len();
+                kept.push(n);
+            }
+        }
+        let edges = edges
+            .into_iter()
+            .filter(|&[p, q]| keep[p] != usize::MAX && keep[q] != usize::MAX)
+            .map(|[p, q]| [keep[p], keep[q]])
+            .collect();
+        // A constraint crossing one already in is left out, as `try_add_constraint` leaves it.
+        let mut cdt =
+            Cdt::try_bulk_load_cdt(kept, edges, |_| {}).map_err(|e| format!("its triangulation failed: {e:?}"))?;
+        // Vertices from this one on came in the last round: a face without them is as it was
+        // (every face an insertion makes holds the new vertex), and its probes' distance is kept.
+        let mut first_new = 0;
         loop {
             let mut tris = Vec::new();
             let mut worst = 0.0f64;
             let mut refine = Vec::new();
+            let mut settled = Vec::new();
             for f in cdt.inner_faces() {
-                let uv = f.vertices().map(|v| [v.position().x, v.position().y]);
+                let uv = f.vertices().map(|v| back(v.position()));
                 let mid = [(uv[0][0] + uv[1][0] + uv[2][0]) / 3.0, (uv[0][1] + uv[1][1] + uv[2][1]) / 3.0];
                 if !fine.inside(mid) {
                     continue;
@@ -885,44 +998,59 @@ impl Face {
                 if area <= 1e-14 * extent {
                     continue; // a sliver of a loop's nearly collinear points, turned either way in space
                 }
-                let t = uv.map(at);
+                let t = f.vertices().map(|v| v.data().p);
                 let nrm = (t[1] - t[0]).cross(&(t[2] - t[0]));
                 let len = nrm.norm();
                 if len <= 1e-12 {
                     continue; // collapsed at a pole or an apex
                 }
+                if let Some(d) = *f.data()
+                    && f.vertices().iter().all(|v| v.fix().index() < first_new)
+                {
+                    worst = worst.max(d);
+                    tris.push(t);
+                    continue;
+                }
                 let edges = f.adjacent_edges();
                 let mut bad: Option<([f64; 2], f64)> = None;
+                let mut largest = 0.0f64;
+                let mut probe = |q: [f64; 2], movable: bool| {
+                    let d = ((at(q) - t[0]).dot(&nrm) / len).abs();
+                    largest = largest.max(d);
+                    if movable && d > target && bad.is_none_or(|(_, b)| d > b) {
+                        bad = Some((q, d));
+                    }
+                };
+                probe(mid, true);
                 for k in 0..3 {
                     let e = middle(uv[k], uv[(k + 1) % 3]);
                     // Constraint edges were split to the chord beforehand: their middles stay.
                     let fixed = edges.iter().any(|h| {
-                        let [p, q] = h.positions();
-                        let m = [(p.x + q.x) / 2.0, (p.y + q.y) / 2.0];
+                        let [p, q] = h.positions().map(back);
+                        let m = middle(p, q);
                         m == e && cdt.is_constraint_edge(h.as_undirected().fix())
                     });
-                    for (q, movable) in [(e, !fixed), (mid, true)] {
-                        let d = ((at(q) - t[0]).dot(&nrm) / len).abs();
-                        worst = worst.max(d);
-                        if movable && d > target && bad.is_none_or(|(_, b)| d > b) {
-                            bad = Some((q, d));
-                        }
-                    }
+                    probe(e, !fixed);
                 }
-                if let Some((q, _)) = bad {
-                    refine.push(q);
+                worst = worst.max(largest);
+                match bad {
+                    Some((q, _)) => refine.push(q),
+                    None => settled.push((f.fix(), largest)),
                 }
                 tris.push(t);
             }
+            for (f, d) in settled {
+                *cdt.face_data_mut(f) = Some(d);
+            }
             if worst <= target || refine.is_empty() || cdt.num_vertices() >= MAX_VERTICES {
-                return (tris, worst * 4.0 / 3.0);
+                return Ok((tris, worst * 4.0 / 3.0));
             }
-            let before = cdt.num_vertices();
+            first_new = cdt.num_vertices();
             for q in refine {
-                cdt.insert(Point2::new(q[0], q[1])).ok();
+                cdt.insert(node(q)).ok();
             }
-            if cdt.num_vertices() == before {
-                return (tris, worst * 4.0 / 3.0); // nothing new: the probes are vertices already
+            if cdt.num_vertices() == first_new {
+                return Ok((tris, worst * 4.0 / 3.0)); // nothing new: the probes are vertices already
             }
         }
     }
@@ -1110,7 +1238,7 @@ mod tests {
     fn triangles_cover_the_face() {
         let plane = Carrier::Analytic(Analytic::Plane { point: P3::origin(), normal: V3::z() });
         let face = Face::new(plane, vec![square(50.0), vec![(circle(P3::origin(), 10.0), false)]], true);
-        let (tris, dev) = face.triangles(1e-6);
+        let (tris, dev) = face.triangles(1e-6).unwrap();
         let area: f64 = tris.iter().map(|t| 0.5 * (t[1] - t[0]).cross(&(t[2] - t[0])).z).sum();
         // The hole's polygon is inscribed within 3/4 of the chord of its circle: its area falls
         // short of the disc's by less than the perimeter times that.
@@ -1127,7 +1255,7 @@ mod tests {
         let seam =
             Curve::Arc { centre: P3::origin(), x: V3::x(), y: -V3::z(), radius: r, t0: (h / r).asin(), t1: PI / 2.0 };
         let dish = Face::new(sphere, vec![vec![(rim, true), (seam.clone(), true), (seam, false)]], false);
-        let (tris, dev) = dish.triangles(1e-3);
+        let (tris, dev) = dish.triangles(1e-3).unwrap();
         assert!(dev <= 1e-3 && tris.len() > 100, "{dev}");
         for t in &tris {
             for p in t {

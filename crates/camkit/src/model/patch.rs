@@ -318,6 +318,28 @@ impl BSpline {
         self.eval_in(u, v, [su, sv])
     }
 
+    /// Point at (u, v): bit for bit `eval(u, v).s`, without the derivatives (a tessellation's
+    /// probes need none).
+    pub fn point(&self, u: f64, v: f64) -> P3 {
+        let [p, q] = self.degree;
+        let [nu, nv] = self.size;
+        let su = find_span(&self.knots[0], nu, p, u);
+        let sv = find_span(&self.knots[1], nv, q, v);
+        let bu = basis(&self.knots[0], su, p, u);
+        let bv = basis(&self.knots[1], sv, q, v);
+        let (mut a, mut wa) = (V3::zeros(), 0.0f64);
+        for (i, b0) in bu.iter().take(p + 1).enumerate() {
+            for (j, c0) in bv.iter().take(q + 1).enumerate() {
+                let k = (su - p + i) * self.size[1] + (sv - q + j);
+                let w = self.weights.as_ref().map_or(1.0, |ws| ws[k]);
+                let b = b0 * c0;
+                a += self.ctrl[k].coords * w * b;
+                wa += w * b;
+            }
+        }
+        if self.weights.is_none() { P3::from(a) } else { P3::from(a / wa) }
+    }
+
     fn eval_in(&self, u: f64, v: f64, [su, sv]: [usize; 2]) -> Derivs {
         let [p, q] = self.degree;
         let bu = basis_derivs(&self.knots[0], su, p, u);
@@ -548,6 +570,18 @@ mod tests {
         let h = std::f64::consts::FRAC_1_SQRT_2;
         let w = vec![vec![1.0, h, 1.0, h, 1.0]; 2];
         BSpline::with_weights(&net, Some(&w), [1, 2], None, Some(vec![0.0, 0.0, 0.0, 0.5, 0.5, 1.0, 1.0, 1.0]))
+    }
+
+    #[test]
+    fn point_is_the_evaluations_point_to_the_bit() {
+        let plain = BSpline::new(&net(7), [3, 3], None, None);
+        let rational = half_cylinder(20.0);
+        for k in 0..=400 {
+            let (u, v) = ((k as f64 * 0.618).fract(), k as f64 / 400.0);
+            for s in [&plain, &rational] {
+                assert_eq!(s.point(u, v), s.eval(u, v).s, "({u}, {v})");
+            }
+        }
     }
 
     #[test]

@@ -65,6 +65,13 @@ impl Revolution {
         }
     }
 
+    /// Point at (u, v): bit for bit `eval(u, v).s`, without the derivatives.
+    pub fn point(&self, u: f64, v: f64) -> P3 {
+        let c = self.profile.point(v);
+        let (s, k) = u.sin_cos();
+        P3::new(c.x * k, c.x * s, c.z)
+    }
+
     /// Unit normal at (u, v): the direction of Su × Sv = ρ·(z′ cos u, z′ sin u, −ρ′), taken from
     /// the profile's tangent so that it stays defined on the axis.
     pub fn normal(&self, u: f64, v: f64) -> Option<V3> {
@@ -124,6 +131,10 @@ mod tests {
             let tube = P3::new(20.0 * x / rho, 20.0 * y / rho, 15.0);
             assert!((f.normal - (f.point - tube) / 5.0).norm() < 1e-9, "{q}: {}", f.normal);
             assert!((s.eval(uv[0], uv[1]).s - f.point).norm() < 1e-12);
+        }
+        for k in 0..=200 {
+            let (u, v) = (k as f64 * 0.071 - 7.0, k as f64 / 200.0);
+            assert_eq!(s.point(u, v), s.eval(u, v).s, "({u}, {v})");
         }
         // Below the quarter the end circle ρ = 25, z = 15 is nearest.
         let (f, _, _) = s.nearest(&P3::new(0.0, 30.0, 10.0), f64::INFINITY).unwrap();

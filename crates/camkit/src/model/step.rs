@@ -390,10 +390,34 @@ impl Reader<'_> {
                 // The curve's own order runs from a to b.
                 let (a, b) = if sense { (v1, v2) } else { (v2, v1) };
                 let curve = self.curve(self.reference(eid, ep, 3)?, a, b, &to_local, &vec_local)?;
+                // A curve that misses its vertices (a moved centre or control point) makes a loop
+                // with gaps: its inside is undefined and the tessellation refines without end.
+                let (s, e) = curve.ends();
+                let off = ((s - a).norm().max((e - b).norm())).min((s - b).norm().max((e - a).norm()));
+                if off > EDGE_FIT || off.is_nan() {
+                    return Err(self.invalid(
+                        eid,
+                        format!("the edge's curve ends {off:.3e} mm from its vertices (more than {EDGE_FIT} mm): the edge and its vertices do not fit together"),
+                    ));
+                }
                 edges.push((curve, sense == along));
             }
             if !orientation {
                 edges = edges.into_iter().rev().map(|(c, f)| (c, !f)).collect();
+            }
+            // Each edge must start where the one before it ends (loop order, the first after the last).
+            let run = |(c, fwd): &(Curve, bool)| {
+                let (s, e) = c.ends();
+                if *fwd { (s, e) } else { (e, s) }
+            };
+            for k in 0..edges.len() {
+                let gap = (run(&edges[k]).1 - run(&edges[(k + 1) % edges.len()]).0).norm();
+                if gap > EDGE_FIT || gap.is_nan() {
+                    return Err(self.invalid(
+                        lid,
+                        format!("edge {} of the loop ends {gap:.3e} mm from the start of the next (more than {EDGE_FIT} mm): the loop is open", k + 1),
+                    ));
+                }
             }
             loops.push(edges);
         }
