@@ -51,7 +51,8 @@ const MIN_PIECE: f64 = 1e-10;
 /// whose bound stands far above what they hold.
 const RHO_ROUND: f64 = 4e-15;
 
-/// Smallest n.z of a piece's middle normal for its plane to bound it.
+/// Smallest n.z of a piece's middle normal for its plane alone to bound it (steeper, the plane
+/// capped at the piece's top does).
 const SLAB_NZ: f64 = 0.02;
 
 /// Golden-section steps of the plane bound's searches along the shadow's edges.
@@ -436,28 +437,112 @@ fn clipped_plane(c: &Cutter, q: [f64; 2], a: &P3, n: &V3, b: &Aabb) -> f64 {
     let corners = [(b.min.x, b.min.y), (b.max.x, b.min.y), (b.max.x, b.max.y), (b.min.x, b.max.y)];
     for k in 0..4 {
         let (p0, p1) = (corners[k], corners[(k + 1) % 4]);
-        let (dx, dy) = (p1.0 - p0.0, p1.1 - p0.1);
-        let (ex, ey) = (p0.0 - q[0], p0.1 - q[1]);
-        // |e + τ d|² ≤ R²: τ between the roots.
-        let aa = dx * dx + dy * dy;
-        let bb = ex * dx + ey * dy;
-        let cc = ex * ex + ey * ey - big_r * big_r;
-        let (t0, t1) = if aa == 0.0 {
-            if cc <= 0.0 { (0.0, 0.0) } else { continue }
-        } else {
-            let disc = bb * bb - aa * cc;
-            if disc < 0.0 {
-                continue;
-            }
-            let r = disc.sqrt();
-            (((-bb - r) / aa).max(0.0), ((-bb + r) / aa).min(1.0))
-        };
-        if t0 > t1 {
-            continue;
+        if let Some((t0, t1)) = in_disc(q, big_r, p0, p1) {
+            let (dx, dy) = (p1.0 - p0.0, p1.1 - p0.1);
+            best = best.max(golden_max(|t| g(p0.0 + t * dx, p0.1 + t * dy), t0, t1));
         }
-        best = best.max(golden_max(|t| g(p0.0 + t * dx, p0.1 + t * dy), t0, t1));
     }
     best
+}
+
+/// As [`clipped_plane`], for a plane too steep to bound a piece alone (n.z ≥ 0, a vertical one
+/// too): the piece lies below both the plane and its box's top, so g = min(plane, top) − f(ρ),
+/// concave over the box's and the disc's common part D, bounds it. Its largest is at the plane's
+/// own drop, at D's nearest point to the axis (where the top holds), at the crease where plane
+/// and top meet (its nearest point to the axis in D, g = top − f(ρ) there), or on D's edges (the
+/// box's sides within the disc, the arc at its uphill point). On a steep wall the box alone
+/// bounds a piece of width w only to its slope times w, and halving never ends.
+fn capped_plane(c: &Cutter, q: [f64; 2], a: &P3, n: &V3, b: &Aabb) -> f64 {
+    let big_r = c.radius();
+    let top = b.max.z;
+    let inbox = |x: f64, y: f64| x >= b.min.x && x <= b.max.x && y >= b.min.y && y <= b.max.y;
+    let rho = |x: f64, y: f64| (x - q[0]).hypot(y - q[1]);
+    // The plane's height capped at the top: behind a vertical plane the top, in front of it −∞.
+    let z = |x: f64, y: f64| {
+        let num = n.x * (x - a.x) + n.y * (y - a.y);
+        let plane = if n.z > 0.0 {
+            a.z - num / n.z
+        } else if num <= 0.0 {
+            f64::INFINITY
+        } else {
+            f64::NEG_INFINITY
+        };
+        plane.min(top)
+    };
+    let g = |x: f64, y: f64| z(x, y) - c.height(rho(x, y).min(big_r));
+    let mut best = f64::NEG_INFINITY;
+    if n.z > 0.0 {
+        let touch = c.drop_on(q, &Plane::new(c, *a, *n));
+        if inbox(touch.contact.x, touch.contact.y) && rho(touch.contact.x, touch.contact.y) <= big_r {
+            best = best.max(if touch.contact.z <= top { touch.tip } else { g(touch.contact.x, touch.contact.y) });
+        }
+    }
+    let (x, y) = (q[0].clamp(b.min.x, b.max.x), q[1].clamp(b.min.y, b.max.y));
+    if rho(x, y) <= big_r {
+        best = best.max(g(x, y));
+    }
+    let h = n.x.hypot(n.y);
+    if h > 0.0 {
+        // The crease n_xy·p = k through the box: p = foot + τ·d, τ clipped by the box's slabs.
+        let k = n.x * a.x + n.y * a.y + n.z * (a.z - top);
+        let (ux, uy) = (n.x / h, n.y / h);
+        let off = (k / h) - (ux * q[0] + uy * q[1]);
+        let foot = (q[0] + ux * off, q[1] + uy * off);
+        let d = (-uy, ux);
+        let (mut t0, mut t1) = (f64::NEG_INFINITY, f64::INFINITY);
+        for (p, dd, lo, hi) in [(foot.0, d.0, b.min.x, b.max.x), (foot.1, d.1, b.min.y, b.max.y)] {
+            if dd == 0.0 {
+                if p < lo || p > hi {
+                    t0 = f64::INFINITY;
+                }
+            } else {
+                let (ta, tb) = ((lo - p) / dd, (hi - p) / dd);
+                t0 = t0.max(ta.min(tb));
+                t1 = t1.min(ta.max(tb));
+            }
+        }
+        if t0 <= t1 {
+            let t = 0.0f64.clamp(t0, t1);
+            let (x, y) = (foot.0 + t * d.0, foot.1 + t * d.1);
+            if rho(x, y) <= big_r {
+                best = best.max(top - c.height(rho(x, y)));
+            }
+        }
+        let (x, y) = (q[0] - big_r * ux, q[1] - big_r * uy);
+        if inbox(x, y) {
+            best = best.max(g(x, y));
+        }
+    }
+    let corners = [(b.min.x, b.min.y), (b.max.x, b.min.y), (b.max.x, b.max.y), (b.min.x, b.max.y)];
+    for k in 0..4 {
+        let (p0, p1) = (corners[k], corners[(k + 1) % 4]);
+        if let Some((t0, t1)) = in_disc(q, big_r, p0, p1) {
+            let (dx, dy) = (p1.0 - p0.0, p1.1 - p0.1);
+            best = best.max(golden_max(|t| g(p0.0 + t * dx, p0.1 + t * dy), t0, t1));
+        }
+    }
+    best
+}
+
+/// The part [t0, t1] of the segment from `p0` to `p1` within the disc of radius `r` about `q`.
+fn in_disc(q: [f64; 2], r: f64, p0: (f64, f64), p1: (f64, f64)) -> Option<(f64, f64)> {
+    let (dx, dy) = (p1.0 - p0.0, p1.1 - p0.1);
+    let (ex, ey) = (p0.0 - q[0], p0.1 - q[1]);
+    // |e + τ d|² ≤ R²: τ between the roots.
+    let aa = dx * dx + dy * dy;
+    let bb = ex * dx + ey * dy;
+    let cc = ex * ex + ey * ey - r * r;
+    let (t0, t1) = if aa == 0.0 {
+        if cc <= 0.0 { (0.0, 0.0) } else { return None }
+    } else {
+        let disc = bb * bb - aa * cc;
+        if disc < 0.0 {
+            return None;
+        }
+        let s = disc.sqrt();
+        (((-bb - s) / aa).max(0.0), ((-bb + s) / aa).min(1.0))
+    };
+    (t0 <= t1).then_some((t0, t1))
 }
 
 /// True when the piece's control points (whose hull holds it) lie beyond the shadow's tangent
@@ -574,10 +659,10 @@ impl Sheet {
         if n.z < 0.0 {
             n = -n;
         }
-        if n.z < SLAB_NZ {
-            return top;
-        }
         let a = net.points().max_by(|x, y| n.dot(&x.coords).total_cmp(&n.dot(&y.coords))).expect("control points");
+        if n.z < SLAB_NZ {
+            return top.min(capped_plane(c, q, &a, &n, &b) + MARGIN);
+        }
         top.min(clipped_plane(c, q, &a, &n, &b) + MARGIN)
     }
 
@@ -1042,6 +1127,62 @@ mod tests {
                     assert!(cap <= tip + 1e-12, "{c:?} {q:?}: a sample of the cap {} above", cap - tip);
                 }
             }
+        }
+    }
+
+    /// A ball beside a plane rising at slope 20 towards its rim, the box's top far above: the
+    /// largest is the plane's own drop, 0.05 mm (R/2s) above the rim's uphill point, inside the
+    /// box; the bound is it to 1e-9 (golden section along the uphill line, where it lies).
+    #[test]
+    fn capped_plane_holds_a_steep_planes_own_drop() {
+        let c = Cutter::Ball { radius: 2.0 };
+        let nz = 0.05f64;
+        let n = V3::new((1.0 - nz * nz).sqrt(), 0.0, nz);
+        let a = P3::new(-2.0, 0.0, 0.0);
+        let b = Aabb { min: P3::new(-2.2, -0.5, -10.0), max: P3::new(-1.5, 0.5, 10.0) };
+        let g = |x: f64| a.z - n.x * (x - a.x) / n.z - c.height(x.abs().min(2.0));
+        let x = golden_arg(g, -2.0, -1.5, 200);
+        let bound = capped_plane(&c, [0.0, 0.0], &a, &n, &b);
+        assert!((bound - g(x)).abs() < 1e-9 && g(x) - g(-2.0) > 0.049, "{bound} vs {} (rim {})", g(x), g(-2.0));
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(200))]
+        /// The steep plane's bound against a dense sampling of what it bounds: min(plane, top)
+        /// − f(ρ) over the box within the disc (a 401² grid, its edges too): never below the
+        /// largest sample, never above the box's own bound.
+        #[test]
+        fn capped_plane_bounds_the_dense_maximum(
+            c in cutters(),
+            lo in prop::array::uniform3(-3.0..3.0f64),
+            size in prop::array::uniform3(0.01..4.0f64),
+            q in prop::array::uniform2(-5.0..5.0f64),
+            nz in prop_oneof![Just(0.0), 0.0..0.05f64],
+            turn in 0.0..TAU,
+            at in prop::array::uniform3(0.0..1.0f64),
+        ) {
+            let b = Aabb { min: P3::new(lo[0], lo[1], lo[2]), max: P3::new(lo[0] + size[0], lo[1] + size[1], lo[2] + size[2]) };
+            let h = (1.0 - nz * nz).sqrt();
+            let n = V3::new(h * turn.cos(), h * turn.sin(), nz);
+            let a = P3::new(b.min.x + at[0] * size[0], b.min.y + at[1] * size[1], b.min.z + at[2] * size[2]);
+            let bound = capped_plane(&c, q, &a, &n, &b);
+            let g = |x: f64, y: f64| {
+                let num = n.x * (x - a.x) + n.y * (y - a.y);
+                let plane = if nz > 0.0 { a.z - num / nz } else if num <= 0.0 { f64::INFINITY } else { f64::NEG_INFINITY };
+                let rho = (x - q[0]).hypot(y - q[1]);
+                if rho > c.radius() { f64::NEG_INFINITY } else { plane.min(b.max.z) - c.height(rho) }
+            };
+            let m = 400;
+            let mut dense = f64::NEG_INFINITY;
+            for i in 0..=m {
+                for j in 0..=m {
+                    dense = dense.max(g(b.min.x + size[0] * i as f64 / m as f64, b.min.y + size[1] * j as f64 / m as f64));
+                }
+            }
+            let rho = b.dist_xy(q);
+            let boxed = if rho > c.radius() { f64::NEG_INFINITY } else { b.max.z - c.height(rho) };
+            prop_assert!(bound + 1e-9 >= dense, "bound {bound} below a sample {dense}");
+            prop_assert!(bound <= boxed + 1e-12, "bound {bound} above the box's {boxed}");
         }
     }
 
