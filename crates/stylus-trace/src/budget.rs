@@ -35,6 +35,9 @@ pub struct Budget {
     pub memory: f64,
     /// CL points and drops (`--max-points`).
     pub points: f64,
+    /// What a point or drop costs on the model against one on an analytic surface
+    /// ([`camkit::model::Model::query_weight`]): the points are counted that many times.
+    pub weight: f64,
 }
 
 /// What a run is estimated to need.
@@ -56,9 +59,18 @@ impl Need {
                 budget.memory / 1e6
             )));
         }
-        if !camkit::budget::fits(self.points, budget.points) {
+        if !camkit::budget::fits(self.points * budget.weight, budget.points) {
+            let weighted = if budget.weight > 1.0 {
+                format!(
+                    " on surfaces {} times as costly as analytic ones ({:.3e} in all)",
+                    budget.weight,
+                    self.points * budget.weight
+                )
+            } else {
+                String::new()
+            };
             return Err(Error::input(format!(
-                "{what} needs an estimated {:.3e} CL points and drops, more than the bound of {:.3e} (--max-points): coarsen the steps, give a smaller --region or raise --max-points",
+                "{what} needs an estimated {:.3e} CL points and drops{weighted}, more than the bound of {:.3e} (--max-points): coarsen the steps, give a smaller --region or raise --max-points",
                 self.points, budget.points
             )));
         }
@@ -214,13 +226,13 @@ mod tests {
         let work = 54_429.0 + 94_128.0 + 39_699.0;
         assert!(need.points < work && 2.0 * need.points > work, "{}", need.points);
         assert!(need.memory > points * 850.0);
-        need.check(&Budget { memory: 2.147e9, points: DEFAULT_POINTS }, "scan").unwrap();
+        need.check(&Budget { memory: 2.147e9, points: DEFAULT_POINTS, weight: 1.0 }, "scan").unwrap();
     }
 
     /// Infinite or absurd estimates are refused, naming the bound.
     #[test]
     fn absurd_needs_are_refused() {
-        let budget = Budget { memory: 2.147e9, points: DEFAULT_POINTS };
+        let budget = Budget { memory: 2.147e9, points: DEFAULT_POINTS, weight: 1.0 };
         let area = Region { x0: -20.0, x1: 20.0, y0: -20.0, y1: 20.0 };
         let e = scan(scan_lines(&area, 0.0, 1e-9), &area, &area, 40.0, 0.0, 1e-9, &STYLUS, &STEPS)
             .check(&budget, "x")
@@ -243,7 +255,7 @@ mod tests {
     /// 2.5e4 drops each, far past the default bound; the dome alone stays far below it.
     #[test]
     fn a_stray_vertex_far_up_is_refused_by_its_climb() {
-        let budget = Budget { memory: 2.147e9, points: DEFAULT_POINTS };
+        let budget = Budget { memory: 2.147e9, points: DEFAULT_POINTS, weight: 1.0 };
         let stylus = Stylus { radius: 5.0, contact_tol: 1e-4 };
         let steps = Steps { chord_tol: 1e-3, max_step: 2.0, min_step: 1e-4 };
         let area = Region { x0: -20.0, x1: 20.0, y0: -20.0, y1: 20.0 };

@@ -71,6 +71,7 @@ pub fn run(args: &Args, tool_path: &str, model: &Model, input: &Input, started: 
     let bounds = Budget {
         memory: args.max_memory.saturating_mul(1_000_000) as f64,
         points: positive(args.max_points, "--max-points")?,
+        weight: model.query_weight(),
     };
     let lines = budget::scan_lines(&region, args.angle, pick);
     budget::fixed_axis(lines, &region, step).check(

@@ -120,7 +120,7 @@ pub(crate) struct Args {
     /// Largest memory (MB: CL points, their rows, the scan lines), estimated before the run; more is refused.
     #[arg(long, default_value_t = budget::DEFAULT_MEMORY_MB, value_name = "MB")]
     max_memory: u64,
-    /// Largest work in CL points and stylus drops (a few µs each), estimated before the run; more is refused.
+    /// Largest work in CL points and stylus drops (a few µs each; ×50 on B-spline surfaces), estimated before the run; more is refused.
     #[arg(long, default_value_t = budget::DEFAULT_POINTS, value_name = "N")]
     max_points: f64,
 }
@@ -210,6 +210,7 @@ fn options(args: &Args, model: &Model, input: &Input) -> Result<Options> {
     let bounds = Budget {
         memory: args.max_memory.saturating_mul(1_000_000) as f64,
         points: positive(args.max_points, "--max-points")?,
+        weight: model.query_weight(),
     };
     let region = region(args, model, stylus.contact_tol)?;
     let b = model.bounds();
