@@ -229,6 +229,90 @@ fn broken_step_geometry_is_refused_with_one_line() {
     }
 }
 
+/// Runs filter `name` with `args` in `w` under a CPU-time limit of `seconds` (a hang guard).
+fn limited(w: &Work, seconds: u32, name: &str, args: &[&str]) -> Outcome {
+    let out = std::process::Command::new("sh")
+        .current_dir(w.path(""))
+        .arg("-c")
+        .arg(format!("ulimit -t {seconds}; exec \"$0\" \"$@\""))
+        .arg(e2e::bin(name))
+        .args(args)
+        .output()
+        .unwrap();
+    Outcome {
+        status: out.status.code().unwrap_or(-1),
+        stdout: out.stdout,
+        stderr: String::from_utf8_lossy(&out.stderr).into_owned(),
+    }
+}
+
+/// What the STEP family's fuzzing found running for minutes or hours, each from one number
+/// changed: an edge circle's centre moved 1e9 mm off its vertices (refused naming the edge); an
+/// interior control point of bspline.step's surface at z = 12 345 mm, a valid 5 km spike (the
+/// gouge check's triangles are refused from their start grid, the stylus's scan by its work
+/// counted at the B-spline surfaces' cost, the drop-cutter traces it, its steep pieces bounded
+/// by their capped planes); and the surface's knots stretched from (0, 1, 2) to (0, 1e8, 2e8),
+/// the same surface (triangulated in (u, v) scaled to lengths: the gouge check gives the same
+/// rows and chord as on the file itself).
+#[test]
+fn extreme_step_geometry_is_refused_or_bounded() {
+    let w = Work::new();
+    let faces = std::fs::read_to_string(data("step/faces.step")).unwrap();
+    let moved = faces.replacen("#81 = CARTESIAN_POINT('',(100.,0.,0.))", "#81 = CARTESIAN_POINT('',(1e9,0.,0.))", 1);
+    assert_ne!(moved, faces);
+    w.write("moved.step", &moved);
+    let line = moved.lines().position(|l| l.starts_with("#73 ")).unwrap() + 1;
+    w.run(BIN, &["moved.step", "-r", "3", "--pick", "10", "-o", "out.csv", "-q"], b"").fails(
+        2,
+        &format!("moved.step:{line}: #73: the edge's curve ends 1.000e9 mm from its vertices (more than 0.01 mm)"),
+    );
+    assert!(!w.exists("out.csv"));
+
+    let good = std::fs::read_to_string(data("step/bspline.step")).unwrap();
+    let spike =
+        good.replacen("#44 = CARTESIAN_POINT('',(30.,26.5,10.5))", "#44 = CARTESIAN_POINT('',(30.,26.5,12345.))", 1);
+    assert_ne!(spike, good);
+    w.write("spike.step", &spike);
+    let high: String = std::iter::once("path,move,x,y,z,i,j,k\n".to_string())
+        .chain((0..40).map(|k| format!("1,{},{},{},6000,0,0,1\n", if k == 0 { "rapid" } else { "line" }, k, k % 7)))
+        .collect();
+    w.write("high.csv", &high);
+    w.write("ball.json", r#"{"kind": "ball", "radius": 3}"#);
+    let check = |m: &str| {
+        limited(
+            &w,
+            60,
+            "tool-attitude",
+            &["high.csv", "--tool", "ball.json", "--axis", "0,0,1", "--model", m, "-o", "t.csv", "--report", "r.json"],
+        )
+    };
+    check("spike.step").fails(2, "the faces' triangles need at least 16785409 vertices");
+    limited(&w, 60, BIN, &["spike.step", "-r", "3", "--pick", "10", "-o", "out.csv", "-q"])
+        .fails(2, "on surfaces 50 times as costly as analytic ones");
+    assert!(!w.exists("out.csv"));
+    limited(
+        &w,
+        60,
+        BIN,
+        &["spike.step", "--tool", "ball.json", "--pick", "6", "--max-step", "3", "-o", "drops.csv", "-q"],
+    )
+    .ok();
+    assert!(table(&w.read("drops.csv")).iter().any(|r| num(r, "z") > 1000.0), "no drop onto the spike");
+
+    let stretched = good.replacen("(4,1,4),(4,4),(0.,1.,2.),(0.,1.),", "(4,1,4),(4,4),(0.,1.E8,2.E8),(0.,1.),", 1);
+    assert_ne!(stretched, good);
+    w.write("stretched.step", &stretched);
+    let b = data("step/bspline.step").display().to_string();
+    let mut seen = Vec::new();
+    for m in [b.as_str(), "stretched.step"] {
+        check(m).ok();
+        let r: serde_json::Value = serde_json::from_str(&w.read("r.json")).unwrap();
+        seen.push((w.read("t.csv"), r["gouge_chord_mm"].as_f64().unwrap()));
+    }
+    assert_eq!(seen[0].0, seen[1].0);
+    assert!(seen[1].1 <= 0.25e-3 && (seen[0].1 - seen[1].1).abs() < 1e-9, "{seen:?}");
+}
+
 /// tool-attitude with --model on the STEP block: the ball end mill on the CL of the dish is
 /// clear (no row deeper than the gouge tolerance, the deepest within the faces' triangles' chord),
 /// and a contact moved 0.1 mm down is found gouging by 0.1·n_z (the normal's z), within the chord.
