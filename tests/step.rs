@@ -247,7 +247,8 @@ fn limited(w: &Work, seconds: u32, name: &str, args: &[&str]) -> Outcome {
 }
 
 /// What the STEP family's fuzzing found running for minutes or hours, each from one number
-/// changed: an edge circle's centre moved 1e9 mm off its vertices (refused naming the edge); an
+/// changed: an edge circle's centre moved 1e9 mm off its vertices (refused naming the edge, as
+/// is a loop whose edges are listed out of order); an
 /// interior control point of bspline.step's surface at z = 12 345 mm, a valid 5 km spike (the
 /// gouge check's triangles are refused from their start grid, the stylus's scan by its work
 /// counted at the B-spline surfaces' cost, the drop-cutter traces it, its steep pieces bounded
@@ -267,6 +268,13 @@ fn extreme_step_geometry_is_refused_or_bounded() {
         &format!("moved.step:{line}: #73: the edge's curve ends 1.000e9 mm from its vertices (more than 0.01 mm)"),
     );
     assert!(!w.exists("out.csv"));
+    let shuffled =
+        faces.replacen("#71 = EDGE_LOOP('',(#72,#96,#112,#129))", "#71 = EDGE_LOOP('',(#72,#112,#96,#129))", 1);
+    assert_ne!(shuffled, faces);
+    w.write("shuffled.step", &shuffled);
+    let line = shuffled.lines().position(|l| l.starts_with("#71 ")).unwrap() + 1;
+    w.run(BIN, &["shuffled.step", "-r", "3", "--pick", "10", "-o", "out.csv", "-q"], b"")
+        .fails(2, &format!("shuffled.step:{line}: #71: edge 1 of the loop ends 6.000e1 mm from the start of the next"));
 
     let good = std::fs::read_to_string(data("step/bspline.step")).unwrap();
     let spike =
