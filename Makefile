@@ -35,9 +35,14 @@ $(BINS): FORCE
 # Property tests run from a fixed seed, so CI reruns exactly the cases checked before landing;
 # `make test PROPTEST_SEED=$$RANDOM` explores new ones.
 PROPTEST_SEED ?= 20261122
+# The tests run on release builds, the binaries `make demo` runs, so the workspace and its
+# dependencies are compiled once (a debug build beside the release one doubled CI's compile time;
+# four internal debug assertions are then left to `cargo test`), by nextest where it is installed
+# (tests of different files side by side on every core), else by cargo test.
+TEST_RUN := $(shell $(CARGO) nextest --version >/dev/null 2>&1 && echo 'nextest run --no-fail-fast' || echo test)
 test:
-	$(CARGO) build --bins
-	PROPTEST_RNG_SEED=$(PROPTEST_SEED) $(CARGO) test --workspace
+	$(CARGO) build --release --bins
+	PROPTEST_RNG_SEED=$(PROPTEST_SEED) $(CARGO) $(TEST_RUN) --release --workspace
 	$(MAKE) demo
 	scripts/check-demos.sh $(OUT)
 

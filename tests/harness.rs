@@ -15,7 +15,11 @@ pub fn bin_dir() -> PathBuf {
 /// Path of a filter binary; panics with a hint if it has not been built.
 pub fn bin(name: &str) -> PathBuf {
     let p = bin_dir().join(name);
-    assert!(p.exists(), "{} is not built: run `cargo build --bins` (make test does)", p.display());
+    assert!(
+        p.exists(),
+        "{} is not built: run `cargo build --bins` (`--release` for `cargo test --release`; make test does)",
+        p.display()
+    );
     p
 }
 
