@@ -74,6 +74,23 @@ fn step_faces_agree_with_the_analytic_model() {
     }
 }
 
+/// A scan line grazing a face's side: faces.step's roof (a half cylinder of radius 10 over z ≥ 0)
+/// is touched by the stylus on the line y = 13 only at its equator, exactly r away. The tracer may
+/// pass such a contact by the contact tolerance, so the coverage check names no gap there (it named
+/// the whole line, 60 mm, and exited 1); the line before it is traced on the offset cylinder.
+#[test]
+fn a_scan_line_grazing_a_face_is_no_gap() {
+    let w = Work::new();
+    let m = data("step/faces.step").display().to_string();
+    w.run(BIN, &[&m, "-r", "3", "--pick", "0.5", "--region=40,100,12.5,13.5", "-q", "-o", "g.csv"], b"").ok();
+    let rows = table(&w.read("g.csv"));
+    let before = rows.iter().filter(|r| (num(r, "y") - 12.5).abs() < 1e-9).count();
+    assert!(before > 20, "{before} rows on y = 12.5");
+    let worst = rows.iter().map(|r| (num(r, "y").hypot(num(r, "z")) - 13.0).abs()).fold(0.0, f64::max);
+    assert!(worst <= 1e-4, "CL off the offset cylinder by {worst}");
+    assert!(rows.iter().all(|r| num(r, "y") <= 13.0 + 1e-9), "a row beyond the roof's shadow");
+}
+
 /// A B-spline face (natural boundary) and the same surface as a model JSON document: identical CL.
 #[test]
 fn bspline_face_gives_the_json_models_cl() {

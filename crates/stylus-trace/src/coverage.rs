@@ -1,6 +1,7 @@
 //! The coverage check of scan mode: every scan line's written CL points against an independent
 //! drop of the stylus ([`crate::envelope`]) at the line's sample positions. A line is covered when
-//! no stretch longer than the gap tolerance, with the model under it, lies outside every pass,
+//! no stretch longer than the gap tolerance, with the model under it (a stylus smaller by the
+//! envelope tolerance lands there), lies outside every pass,
 //! and no CL point lies below the upper envelope by more than the envelope tolerance, measured
 //! across the envelope (the vertical depth times the z of the envelope's normal there), and with
 //! the envelope taken as its lowest within that tolerance horizontally, so a pass climbing a
@@ -79,6 +80,10 @@ pub fn check(
     round: &(dyn Fn(f64) -> f64 + Sync),
 ) -> Coverage {
     let dropper = Dropper::new(model, radius, (tol.below * 0.1).max(1e-9));
+    // The model is under a stretch no pass covers where a stylus smaller by the envelope's
+    // tolerance still lands: the tracer may pass a contact by that depth, and a line grazing a
+    // face's side (faces.step's roof at y = ±13, touched at its equator at exactly r) is no gap.
+    let under = (radius - tol.below).max(0.5 * radius);
     let lines = scan::lines(scan);
     let per_line: Vec<LineFigures> = lines
         .par_iter()
@@ -89,7 +94,7 @@ pub fn check(
                 .filter(|p| p.unit == k)
                 .map(|p| p.points.iter().map(|q| q.centre.map(round)).collect())
                 .collect();
-            check_line(model, &dropper, k, line, &written, tol)
+            check_line(model, (&dropper, under), k, line, &written, tol)
         })
         .collect();
     let mut out = Coverage { lines: lines.len(), ..Coverage::default() };
@@ -126,13 +131,20 @@ struct LineFigures {
     defects: Vec<Defect>,
 }
 
-fn check_line(model: &Model, d: &Dropper, k: usize, line: &Line, passes: &[Vec<P3>], tol: &Tolerances) -> LineFigures {
+fn check_line(
+    model: &Model,
+    (d, under): (&Dropper, f64),
+    k: usize,
+    line: &Line,
+    passes: &[Vec<P3>],
+    tol: &Tolerances,
+) -> LineFigures {
     let mut f = LineFigures::default();
     let at = |s: f64| line.at(s, 0.0);
     let drop = |s: f64, f: &mut LineFigures| {
         f.drops += 1;
         let p = at(s);
-        d.drop(p.x, p.y)
+        d.drop_of(p.x, p.y, under)
     };
     // Covered stretches of the line parameter, merged.
     let mut covered: Vec<(f64, f64)> = passes

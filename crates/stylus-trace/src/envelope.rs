@@ -87,7 +87,13 @@ impl<'a> Dropper<'a> {
     /// can pass the whole model by. Surfaces the vertical touches at every height (a vertical
     /// unbounded plane or cylinder) are left out.
     pub fn drop(&self, x: f64, y: f64) -> Option<f64> {
-        let r = self.radius;
+        self.drop_of(x, y, self.radius)
+    }
+
+    /// [`Dropper::drop`] for a stylus of radius `r`, no larger than the one prepared for (the
+    /// surfaces' search ranges and the meshes' grids reach that far).
+    pub fn drop_of(&self, x: f64, y: f64, r: f64) -> Option<f64> {
+        let r = r.min(self.radius);
         let mut best: Option<f64> = None;
         for part in &self.parts {
             let take = raise;
@@ -123,7 +129,7 @@ impl<'a> Dropper<'a> {
                     }
                     let place = |p: P3| surface.placement.map_or(p, |iso| iso * p);
                     for curve in face.edges() {
-                        if let Some(z) = self.drop_on_curve(surface, curve, &place, x, y, best) {
+                        if let Some(z) = self.drop_on_curve(surface, curve, &place, [x, y, r], best) {
                             take(&mut best, z);
                         }
                     }
@@ -360,18 +366,17 @@ fn face_contacts(s: &Surface, face: &Face, x: f64, y: f64, r: f64) -> Vec<f64> {
 }
 
 impl Dropper<'_> {
-    /// The highest centre z over (x, y) touching a boundary curve of a face, above `best`:
-    /// segments and horizontal arcs in closed form, other curves by the certified search.
+    /// The highest centre z over (x, y) of a stylus of radius r touching a boundary curve of a
+    /// face, above `best`: segments and horizontal arcs in closed form, other curves by the
+    /// certified search.
     fn drop_on_curve(
         &self,
         s: &Surface,
         curve: &Curve,
         place: &dyn Fn(P3) -> P3,
-        x: f64,
-        y: f64,
+        [x, y, r]: [f64; 3],
         best: Option<f64>,
     ) -> Option<f64> {
-        let r = self.radius;
         let local = |q: P3| s.placement.map_or(q, |iso| iso.inverse_transform_point(&q));
         match curve {
             Curve::Line { a, b } => drop_on_segment(&place(*a), &place(*b), x, y, r),
