@@ -28,14 +28,14 @@ pub mod step;
 pub mod trochoid;
 pub mod uncut;
 
-use camkit::contour::OffsetOptions;
 use camkit::contour::pocket::{Direction, Pass, Passes, PocketOptions, pocket_stepped};
 use camkit::contour::region::Region;
+use camkit::contour::{OffsetOptions, SegSet};
 use camkit::geom::P2;
 use engagement::Cut;
 use feed::{FeedModel, Load};
 use medial::{Medial, MedialOptions, medial_axis};
-use program::{Program, Tag, clearance, point_clearance};
+use program::{Program, Tag, point_clearance};
 use rayon::prelude::*;
 use std::collections::HashMap;
 
@@ -301,11 +301,10 @@ pub fn analyse_after(
         .count();
     let (feeds, minutes, minutes_constant) = times(&program, &samples, &loads, &s.feed);
     let (_, minutes_chip_only, minutes_constant_chip_only) = times(&program, &samples, &loads, &s.feed.chip_only());
-    let wall_clearance = program
-        .moves
-        .iter()
-        .map(|m| regions.iter().map(|r| clearance(&m.seg, r)).fold(f64::INFINITY, f64::min))
-        .fold(f64::INFINITY, f64::min);
+    // The least so far bounds the search of the walls' index for each move: measured move by
+    // move against every wall piece, a pocket 3x as tall took 8x the time.
+    let walls = SegSet::new(regions.iter().flat_map(|r| r.loops()));
+    let wall_clearance = program.moves.iter().fold(f64::INFINITY, |least, m| walls.distance_within(&m.seg, least));
     Analysed {
         program,
         samples,

@@ -17,7 +17,7 @@ pub mod svg_in;
 pub mod table;
 mod verify;
 
-pub(crate) use verify::SegSet;
+pub use verify::SegSet;
 
 pub use offset::{Offset, OffsetError, OffsetOptions, offset_contour, offset_region};
 pub use verify::{Check, Defect};

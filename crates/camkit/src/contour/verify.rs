@@ -97,7 +97,8 @@ impl Defect {
 }
 
 /// Pieces of several contours with a spatial index and their neighbours along each contour.
-pub(crate) struct SegSet {
+pub struct SegSet {
+    /// The pieces, contour by contour in order.
     pub segs: Vec<Seg>,
     /// Start and end point of each piece (computed once: an arc's cost a sine and a cosine).
     ends: Vec<(P2, P2)>,
@@ -226,6 +227,14 @@ impl SegSet {
         });
         out.sort_unstable();
         out
+    }
+
+    /// The least of `within` and the distances from `s` to the pieces, exactly: only the pieces
+    /// the index finds within `within` of `s` are measured, so a running minimum over many
+    /// segments (`within` the least so far) costs about the pieces near each, not all of them.
+    pub fn distance_within(&self, s: &Seg, within: f64) -> f64 {
+        let (lo, hi) = s.bounds();
+        self.near(&lo, &hi, within).into_iter().map(|i| self.segs[i].min_distance(s)).fold(within, f64::min)
     }
 
     /// First point where two pieces that do not follow each other meet: a crossing or a touch.
