@@ -922,3 +922,40 @@ fn rows_streamed_from_a_file_or_stdin_and_a_fault_on_the_last_row() {
     w.run(BIN, &args("-", "bad.nc"), bad.as_bytes()).fails(2, &format!("stdin:{last}:9 (f)"));
     assert!(!w.exists("bad.nc"));
 }
+
+/// A job's faults are named stage by stage, each the first of its kind over the whole input,
+/// although the rows are read twice (checked, then linked as they come): a bad number on the last
+/// row before a row outside the stock; a row outside the stock (the last) before a pass starting
+/// inside the part; a pass starting inside the part (the second pass) before the first pass's
+/// tool axis, which linking cannot approach along; exit 2 and no program each time.
+#[test]
+fn job_faults_are_named_stage_by_stage_over_the_whole_input() {
+    let w = Work::new();
+    w.write("tool.json", r#"{"kind": "flat", "radius": 4, "number": 7, "feed": 800, "plunge_feed": 150}"#);
+    w.write(
+        "pocket.csv",
+        "path,move,x,y,z,xc,yc\n0,line,0,0,0,,\n0,line,100,0,0,,\n0,line,100,60,0,,\n0,line,0,60,0,,\n\
+         0,line,0,0,0,,\n1,line,58,30,0,,\n1,ccw,42,30,0,50,30\n1,ccw,58,30,0,50,30\n",
+    );
+    w.write(
+        "setup.json",
+        r#"{"tool": "tool.json", "stock": {"min": [0, 0, -20], "max": [100, 60, 0]},
+  "part": {"contours": "pocket.csv", "floor": -12}, "clearance_height": 25, "safe_height": 5, "approach": 1}"#,
+    );
+    let tilted = "path,move,x,y,z,i,j,k\n0,rapid,10,10,-5,0.28,0.96,0\n0,line,30,10,-5,0,0,1\n";
+    let inside = "1,rapid,48,30,-6,0,0,1\n1,line,49,30,-6,0,0,1\n";
+    let outside = "2,rapid,20,50,-6,0,0,1\n2,line,150,50,-6,0,0,1\n";
+    let m = machine("three-axis.json");
+    let cases = [
+        (format!("{tilted}{inside}{outside}2,line,20,50,-6x,0,0,1\n"), "rows.csv:8:"),
+        (format!("{tilted}{inside}{outside}"), "(stock): the stock does not contain the toolpath: rows.csv:7"),
+        (format!("{tilted}{inside}"), "(part): the pass starting at rows.csv:4"),
+        (tilted.to_string(), "rows.csv:2 (i,j,k): the pass starts with the tool axis 90.0° from vertical"),
+    ];
+    for (rows, needle) in cases {
+        w.write("rows.csv", rows);
+        let o = w.run(BIN, &["rows.csv", "--machine", &m, "--setup", "setup.json", "-o", "p.ngc"], b"");
+        o.fails(2, needle);
+        assert!(!w.exists("p.ngc"), "{needle}");
+    }
+}

@@ -1,9 +1,13 @@
-//! Input from a path or standard input, and output written whole or not at all.
+//! Input from a path or standard input, output written whole or not at all, and spools (what a
+//! later stage reads back, kept on disk: [`spool`]).
 
 use crate::error::{Error, Result};
 use std::io::{Read, Write};
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
+
+pub mod spool;
+pub use spool::{Get, Record, RecordSpool, Records, Share, Spool, Spooled, View};
 
 /// The temporary files outputs are being written to: an interrupt removes them (see
 /// [`remove_pending`]), so that a run stopped while writing or committing leaves nothing behind.

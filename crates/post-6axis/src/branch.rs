@@ -4,6 +4,8 @@
 
 use crate::plan::{Cl, Machine, Options, PlanError, angle_between};
 use camkit::geom::V3;
+use camkit::io::spool::{Put, Take};
+use camkit::io::{Get, Record, RecordSpool};
 use camkit::kinematics::{Choice, Orientations, principal_deg};
 
 /// Largest axis error of a pose whose primary angle is held inside the singular cone, as a share
@@ -29,10 +31,10 @@ pub struct Next {
 }
 
 /// The poses chosen for every row.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Debug)]
 pub struct Chosen {
     /// One pose per row.
-    pub choices: Vec<Choice>,
+    pub choices: Choices,
     /// Total rotary move (degrees, with tie-breaks) of the sequence.
     pub cost: f64,
     /// Wrapping axes unwound at pass starts.
@@ -222,6 +224,7 @@ fn same_state(m: &Machine, a: &[f64; 2], b: &[f64; 2]) -> bool {
 }
 
 /// One state of the search at a row.
+#[derive(Clone, Copy, Debug)]
 struct Node {
     choice: Choice,
     cost: f64,
@@ -229,23 +232,91 @@ struct Node {
     unwinds: usize,
 }
 
+fn put_choice(c: &Choice, out: &mut Put) {
+    out.f64(c.rot[0]).f64(c.rot[1]).u8(c.branch as u8).u8(u8::from(c.singular));
+}
+
+fn take_choice(bytes: &mut Take) -> Choice {
+    Choice { rot: [bytes.f64(), bytes.f64()], branch: usize::from(bytes.u8()), singular: bytes.u8() != 0 }
+}
+
+impl Record for Node {
+    const SIZE: usize = 18 + 24;
+    fn put(&self, out: &mut Put) {
+        put_choice(&self.choice, out);
+        out.f64(self.cost).u64(self.parent as u64).u64(self.unwinds as u64);
+    }
+    fn take(bytes: &mut Take) -> Self {
+        let choice = take_choice(bytes);
+        let (cost, parent, unwinds) = (bytes.f64(), bytes.u64(), bytes.u64());
+        Node { choice, cost, parent: usize::try_from(parent).unwrap_or(usize::MAX), unwinds: unwinds as usize }
+    }
+}
+
+/// A chosen pose as a record.
+#[derive(Clone, Copy, Debug)]
+struct Picked(Choice);
+
+impl Record for Picked {
+    const SIZE: usize = 18;
+    fn put(&self, out: &mut Put) {
+        put_choice(&self.0, out);
+    }
+    fn take(bytes: &mut Take) -> Self {
+        Picked(take_choice(bytes))
+    }
+}
+
+/// One pose per row, by row index, kept on disk beyond a page (the search finds them from the
+/// last row back, and keeps them in that order).
+#[derive(Debug, Default)]
+pub struct Choices {
+    back: RecordSpool<Picked>,
+}
+
+impl Choices {
+    /// Rows.
+    pub fn len(&self) -> usize {
+        self.back.len()
+    }
+
+    /// True if there are none.
+    pub fn is_empty(&self) -> bool {
+        self.back.is_empty()
+    }
+
+    /// The pose of row `i`.
+    pub fn get(&mut self, i: usize) -> Choice {
+        let n = self.back.len();
+        self.back.get(n - 1 - i).0
+    }
+
+    /// Replaces the pose of row `i`.
+    pub fn set(&mut self, i: usize, c: &Choice) {
+        let n = self.back.len();
+        self.back.set(n - 1 - i, &Picked(*c));
+    }
+}
+
 /// The sequence of poses, one per row, with the least total rotary move among those that stay
 /// within the limits, move continuously within each pass and hold the axis within tolerance in
 /// the singular cone. Refused (the first row no sequence reaches, and why) only when none exists.
-pub fn choose(rows: &[Cl], m: &Machine, opts: &Options) -> Result<Chosen, PlanError> {
+pub fn choose<R: Get<Cl> + ?Sized>(rows: &R, m: &Machine, opts: &Options) -> Result<Chosen, PlanError> {
     let start = Choice { rot: home(m), branch: 0, singular: false };
-    let mut nodes: Vec<Node> = Vec::with_capacity(rows.len() * 2);
-    let mut layer: Vec<usize> = Vec::new();
-    for (i, row) in rows.iter().enumerate() {
-        let o = orientations(m, row, i)?;
+    // Every state of every row, on disk beyond a page; the states of the row at hand in memory.
+    let mut nodes: RecordSpool<Node> = RecordSpool::new();
+    let mut layer: Vec<(usize, Node)> = Vec::new();
+    for i in 0..rows.len() {
+        let row = rows.get(i);
+        let o = orientations(m, &row, i)?;
         let mut next: Vec<Node> = Vec::new();
         let prevs: Vec<(usize, Choice, f64)> = if i == 0 {
             vec![(usize::MAX, start, 0.0)]
         } else {
-            layer.iter().map(|&p| (p, nodes[p].choice, nodes[p].cost)).collect()
+            layer.iter().map(|(p, n)| (*p, n.choice, n.cost)).collect()
         };
         for &(parent, pc, pcost) in &prevs {
-            for s in successors(m, opts, row, &o, &pc.rot, false).0 {
+            for s in successors(m, opts, &row, &o, &pc.rot, false).0 {
                 let cost = pcost + s.cost;
                 let node = Node { choice: s.choice, cost, parent, unwinds: s.unwinds };
                 match next.iter_mut().find(|n| same_state(m, &n.choice.rot, &s.choice.rot)) {
@@ -257,7 +328,7 @@ pub fn choose(rows: &[Cl], m: &Machine, opts: &Options) -> Result<Chosen, PlanEr
         }
         if next.is_empty() {
             let mut why: Vec<String> =
-                prevs.iter().flat_map(|(_, pc, _)| successors(m, opts, row, &o, &pc.rot, true).1).collect();
+                prevs.iter().flat_map(|(_, pc, _)| successors(m, opts, &row, &o, &pc.rot, true).1).collect();
             why.sort();
             why.dedup();
             return Err(PlanError {
@@ -269,23 +340,25 @@ pub fn choose(rows: &[Cl], m: &Machine, opts: &Options) -> Result<Chosen, PlanEr
                 unreachable: true,
             });
         }
-        layer = (nodes.len()..nodes.len() + next.len()).collect();
-        nodes.extend(next);
+        let base = nodes.len();
+        layer = next.iter().enumerate().map(|(k, n)| (base + k, *n)).collect();
+        for n in &next {
+            nodes.push(n);
+        }
     }
-    let Some(&best) = layer.iter().min_by(|&&a, &&b| nodes[a].cost.total_cmp(&nodes[b].cost)) else {
-        return Ok(Chosen { choices: Vec::new(), cost: 0.0, unwinds: 0 });
+    let Some(&(best, Node { cost, .. })) = layer.iter().min_by(|a, b| a.1.cost.total_cmp(&b.1.cost)) else {
+        return Ok(Chosen { choices: Choices::default(), cost: 0.0, unwinds: 0 });
     };
-    let cost = nodes[best].cost;
-    let mut choices = Vec::with_capacity(rows.len());
+    let mut back = RecordSpool::new();
     let mut unwinds = 0;
     let mut at = best;
     while at != usize::MAX {
-        choices.push(nodes[at].choice);
-        unwinds += nodes[at].unwinds;
-        at = nodes[at].parent;
+        let node = nodes.get(at);
+        back.push(&Picked(node.choice));
+        unwinds += node.unwinds;
+        at = node.parent;
     }
-    choices.reverse();
-    Ok(Chosen { choices, cost, unwinds })
+    Ok(Chosen { choices: Choices { back }, cost, unwinds })
 }
 
 #[cfg(test)]
@@ -353,12 +426,13 @@ mod tests {
             }
             let exhaustive = brute_force(&rows, &m, &opts, 0, &home(&m));
             match (choose(&rows, &m, &opts), exhaustive) {
-                (Ok(c), Some(best)) => {
+                (Ok(mut c), Some(best)) => {
+                    let choices: Vec<Choice> = (0..c.choices.len()).map(|i| c.choices.get(i)).collect();
                     prop_assert!((c.cost - best).abs() <= 1e-6 * (1.0 + best), "search {} exhaustive {best}", c.cost);
                     // The sequence is one the rules allow, and costs what the search says.
                     let mut prev = home(&m);
                     let mut total = 0.0;
-                    for (i, (r, choice)) in rows.iter().zip(&c.choices).enumerate() {
+                    for (i, (r, choice)) in rows.iter().zip(&choices).enumerate() {
                         let o = orientations(&m, r, i).unwrap();
                         let (succ, _) = successors(&m, &opts, r, &o, &prev, false);
                         let s = succ.iter().find(|s| same_state(&m, &s.choice.rot, &choice.rot));
@@ -374,6 +448,32 @@ mod tests {
         }
     }
 
+    /// Over passes of thousands of rows (the search's states and the poses on disk, many pages
+    /// of them), every pose chosen is a successor of the one before and the costs add up to the
+    /// search's total.
+    #[test]
+    fn long_programs_choose_a_sequence_of_successors() {
+        let (doc, chain) = machine("paper002-ac.json");
+        let m = crate::planning(&doc, &chain);
+        let opts = Options::default();
+        let rows: Vec<Cl> =
+            (0..6000).map(|k| row(25.0 + 15.0 * (k as f64 * 0.003).sin(), 0.05 * k as f64, k, k % 1500 == 0)).collect();
+        let mut c = choose(&rows, &m, &opts).expect("reachable");
+        assert_eq!(c.choices.len(), rows.len());
+        let mut prev = home(&m);
+        let mut total = 0.0;
+        for (i, r) in rows.iter().enumerate() {
+            let choice = c.choices.get(i);
+            let o = orientations(&m, r, i).unwrap();
+            let (succ, _) = successors(&m, &opts, r, &o, &prev, false);
+            let s = succ.iter().find(|s| same_state(&m, &s.choice.rot, &choice.rot));
+            assert!(s.is_some(), "row {i}: {choice:?} is not a successor of {prev:?}");
+            total += s.unwrap().cost;
+            prev = choice.rot;
+        }
+        assert!((total - c.cost).abs() <= 1e-6 * (1.0 + total), "{total} {}", c.cost);
+    }
+
     /// The sweep of paper 002's A/C machine from 25° one way to 110° the other in the XZ plane: the
     /// greedy choice from home (C −90°) runs A into its −30° limit; the search takes C 90° for the
     /// whole pass.
@@ -382,9 +482,10 @@ mod tests {
         let (doc, chain) = machine("paper002-ac.json");
         let m = crate::planning(&doc, &chain);
         let rows: Vec<Cl> = (0..28).map(|k| row(-25.0 + 5.0 * k as f64, 0.0, k, k == 0)).collect();
-        let c = choose(&rows, &m, &Options::default()).expect("one branch covers the pass");
-        assert!(c.choices.iter().all(|c| c.singular || (c.rot[0] - 90.0).abs() < 1e-9), "{:?}", c.choices);
-        let a: Vec<f64> = c.choices.iter().map(|c| c.rot[1]).collect();
+        let mut c = choose(&rows, &m, &Options::default()).expect("one branch covers the pass");
+        let choices: Vec<Choice> = (0..c.choices.len()).map(|i| c.choices.get(i)).collect();
+        assert!(choices.iter().all(|c| c.singular || (c.rot[0] - 90.0).abs() < 1e-9), "{choices:?}");
+        let a: Vec<f64> = choices.iter().map(|c| c.rot[1]).collect();
         assert!((a[0] + 25.0).abs() < 1e-9 && (a[27] - 110.0).abs() < 1e-9, "{a:?}");
         // Past A's 120° limit on both branches: refused at that row, naming the limit.
         let mut far = rows.clone();

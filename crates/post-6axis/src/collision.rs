@@ -22,6 +22,7 @@ use camkit::collide::solid::{Body, Placement, Solid};
 use camkit::collide::walls::{Column, Walls};
 use camkit::contour::Seg;
 use camkit::doc::Job;
+use camkit::error::{Error, Result};
 use camkit::geom::{P2, P3, V3};
 use rayon::prelude::*;
 
@@ -194,6 +195,9 @@ fn xy(p: &P3) -> P2 {
     P2::new(p.x, p.y)
 }
 
+/// Blocks measured against a 3-D part at once, in parallel.
+pub const SOLID_CHUNK: usize = 16_384;
+
 /// How far beyond the allowance and the tolerance clearances from a 3-D part are measured (mm).
 pub const SOLID_BAND: f64 = 0.1;
 
@@ -268,70 +272,84 @@ fn placement(r: &Reading, q: &camkit::kinematics::Joints, sigma: Option<f64>) ->
 
 impl Check<'_> {
     /// Every block against the 3-D part, in parallel (the part does not change): exact casts
-    /// where the body and the block allow them, samples every `step` mm otherwise.
+    /// where the body and the block allow them, samples every `step` mm otherwise. The poses are
+    /// read as they come, [`SOLID_CHUNK`] blocks at a time.
     pub fn run_solid(
         &self,
-        poses: &[Option<NcPose>],
+        poses: impl Iterator<Item = Result<Option<NcPose>>>,
         r: &Reading,
         step: f64,
         tick: &(dyn Fn() + Sync),
-    ) -> SolidOutcome {
-        let Some((solid, body)) = self.solid else { return SolidOutcome::default() };
+    ) -> Result<SolidOutcome> {
+        let mut o = SolidOutcome::default();
+        let Some((solid, body)) = self.solid else { return Ok(o) };
         let job = self.job;
         let limit = job.allowance - job.tolerance;
         // Clearances are measured in a band 0.1 mm beyond the allowance and the tolerance (farther
         // ones are reported as the band's edge): the fewer triangles a query meets, the faster.
         let reach = job.allowance.max(0.0) + job.tolerance + SOLID_BAND;
-        let mut pairs = Vec::new();
-        let mut prev: Option<&NcPose> = None;
+        let mut pairs = Vec::with_capacity(SOLID_CHUNK);
+        let mut prev: Option<NcPose> = None;
+        let mut measure = |pairs: &mut Vec<(NcPose, NcPose)>| {
+            let each: Vec<BlockSolid> = pairs
+                .par_iter()
+                .map(|(a, b)| {
+                    tick();
+                    block_solid(solid, body, r, a, b, limit, reach, step)
+                })
+                .collect();
+            pairs.clear();
+            for b in each {
+                least(if b.rapid { &mut o.rapid } else { &mut o.feed }, b.least, b.line);
+                match b.samples {
+                    None => o.cast += 1,
+                    Some(n) => {
+                        o.sampled += 1;
+                        o.samples += n;
+                    }
+                }
+                if let Some(c) = b.bad {
+                    o.collisions += 1;
+                    if o.first.is_none() {
+                        o.first = Some((b.line, b.rapid, c));
+                    }
+                }
+            }
+        };
         for pose in poses {
+            let pose = pose?;
             if let (Some(b), Some(a)) = (pose, prev) {
                 pairs.push((a, b));
-            }
-            prev = pose.as_ref();
-        }
-        let each: Vec<BlockSolid> = pairs
-            .par_iter()
-            .map(|&(a, b)| {
-                tick();
-                block_solid(solid, body, r, a, b, limit, reach, step)
-            })
-            .collect();
-        let mut o = SolidOutcome::default();
-        for b in each {
-            least(if b.rapid { &mut o.rapid } else { &mut o.feed }, b.least, b.line);
-            match b.samples {
-                None => o.cast += 1,
-                Some(n) => {
-                    o.sampled += 1;
-                    o.samples += n;
+                if pairs.len() == SOLID_CHUNK {
+                    measure(&mut pairs);
                 }
             }
-            if let Some(c) = b.bad {
-                o.collisions += 1;
-                if o.first.is_none() {
-                    o.first = Some((b.line, b.rapid, c));
-                }
-            }
+            prev = pose;
         }
-        o
+        measure(&mut pairs);
+        Ok(o)
     }
 
     /// Follows the program's blocks and measures every one; `tick` once per block.
-    pub fn run(&self, poses: &[Option<NcPose>], reading: &Reading, tick: &dyn Fn()) -> Result<Outcome, String> {
+    pub fn run(
+        &self,
+        poses: impl Iterator<Item = Result<Option<NcPose>>>,
+        reading: &Reading,
+        tick: &dyn Fn(),
+    ) -> Result<Outcome> {
         let job = self.job;
         let tool = &job.tool;
         let cutter = Cutter::of(tool);
         let mut map = Material::new(&job.stock, job.resolution, crate::link::MAX_NODES)
-            .map_err(|n| format!("the material map would have {n} nodes"))?;
+            .map_err(|n| Error::runtime(format!("the material map would have {n} nodes")))?;
         let length = tool.length.unwrap_or(6.0 * tool.radius);
         let column = Column { radius: tool.radius, length, holder_radius: 0.5 * tool.holder_diameter.unwrap_or(0.0) };
         let tol = job.tolerance;
         let mut o = Outcome::default();
-        let mut prev: Option<&NcPose> = None;
+        let mut prev: Option<NcPose> = None;
         for pose in poses {
             tick();
-            let Some(b) = pose else {
+            let Some(b) = pose? else {
                 prev = None;
                 continue;
             };
@@ -341,6 +359,7 @@ impl Check<'_> {
                 continue;
             };
             prev = Some(b);
+            let (a, b) = (&a, &b);
             let rapid = b.rapid;
             if rapid {
                 o.rapid_blocks += 1;

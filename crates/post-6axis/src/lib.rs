@@ -17,10 +17,11 @@ pub mod readback;
 
 use camkit::doc::machine::Machine;
 use camkit::error::{Error, Location, Result};
-use camkit::gcode::read_axes;
+use camkit::io::{Get, Share, Spool, Spooled};
 use camkit::kinematics::{Chain, Solver};
 use camkit::table::{Col, Move, Row, Schema};
 use plan::{Cl, ClArc, SpindleSetup};
+use std::io::Write;
 
 /// What the user asks of one run.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -170,10 +171,10 @@ pub fn planning<'a>(machine: &Machine, chain: &'a Chain) -> plan::Machine<'a> {
 }
 
 /// Everything one run of the post produced.
-#[derive(Clone, Debug)]
+#[derive(Debug)]
 pub struct Posted {
-    /// The program text.
-    pub text: Vec<u8>,
+    /// The program text, on disk.
+    pub program: Spooled,
     /// Planning figures.
     pub plan: plan::Stats,
     /// Writing figures.
@@ -186,14 +187,15 @@ pub struct Posted {
 
 /// Largest tip error (mm) that rounding the written numbers can add: linear decimals in 3-D and
 /// the rotary decimals at the largest lever arm of the rows.
-fn rounding_allowance(rows: &[Cl], chain: &Chain, machine: &Machine) -> f64 {
+fn rounding_allowance<R: Get<Cl> + ?Sized>(rows: &R, chain: &Chain, machine: &Machine) -> f64 {
     let d = machine.program.decimals;
     let unit = if machine.program.units == camkit::doc::machine::UnitsDoc::Inch { 25.4 } else { 1.0 };
     let lin = 0.5 * 10f64.powi(-(d.linear as i32)) * unit * 3f64.sqrt();
     let offsets: f64 =
         chain.links().iter().map(|l| if let camkit::kinematics::Link::Offset(v) = l { v.norm() } else { 0.0 }).sum();
-    let reach =
-        rows.iter().map(|r| (r.tip.coords - chain.frame()).norm()).fold(0.0, f64::max) + chain.frame().norm() + offsets;
+    let reach = (0..rows.len()).map(|i| (rows.get(i).tip.coords - chain.frame()).norm()).fold(0.0, f64::max)
+        + chain.frame().norm()
+        + offsets;
     let rot = 0.5 * 10f64.powi(-(d.rotary as i32));
     lin + rot.to_radians() * reach * chain.rotaries().len() as f64
 }
@@ -215,7 +217,12 @@ pub const CHECK_SAMPLES: usize = 8;
 
 /// What planning works to for `rows` on `machine`: the tolerances less what the program's
 /// decimals may add in rounding (refused when that leaves under a quarter of one).
-fn plan_options(rows: &[Cl], machine: &Machine, chain: &Chain, s: &Settings) -> Result<plan::Options> {
+fn plan_options<R: Get<Cl> + ?Sized>(
+    rows: &R,
+    machine: &Machine,
+    chain: &Chain,
+    s: &Settings,
+) -> Result<plan::Options> {
     let allowance = rounding_allowance(rows, chain, machine);
     let tol_used = s.tol - allowance;
     if tol_used < s.tol / 4.0 {
@@ -258,60 +265,84 @@ fn plan_options(rows: &[Cl], machine: &Machine, chain: &Chain, s: &Settings) -> 
     })
 }
 
-/// Plans, writes and reads back the program for CL rows.
-pub fn post(
-    rows: &[Cl],
+/// Plans, writes and reads back the program for CL rows (in memory, or on disk as
+/// [`camkit::io::Records`]): the program goes to disk as it is written, and is read back from
+/// there a block at a time.
+pub fn post<R: Share<Cl> + ?Sized>(
+    rows: &R,
     file: &str,
     machine: &Machine,
     chain: &Chain,
     s: &Settings,
     comments: Vec<String>,
 ) -> Result<Posted> {
-    let opts = plan_options(rows, machine, chain, s)?;
+    let view = rows.view();
+    let opts = plan_options(&view, machine, chain, s)?;
     let m = planning(machine, chain);
     // Blocks are written as they are planned; a move without a feed is refused once planning
     // has found nothing worse (as when the whole plan came first).
     let wopts = nc::WriteOptions { rotary_radius: s.rotary_radius, comments };
     let mut writer = nc::Writer::new(machine, chain, &wopts);
+    let spool_error = |e: std::io::Error| Error::runtime(format!("the program cannot be spooled: {e}"));
+    let mut spool = Spool::new().map_err(spool_error)?;
     let mut no_feed = None;
-    let stats = plan::plan_each(rows, &m, &opts, &mut |step| {
+    let mut failed = None;
+    let stats = plan::plan_each(&view, &m, &opts, &mut |step| {
         if no_feed.is_none() {
             no_feed = writer.push(step).err();
         }
+        if failed.is_none() && writer.pending() >= SPOOL_BYTES {
+            failed = writer.write_text(&mut spool).err();
+        }
     })
     .map_err(|e| {
-        let loc = Location::file(file).line(rows[e.row].line).field("i,j,k");
+        let loc = Location::file(file).line(view.get(e.row).line).field("i,j,k");
         if e.unreachable { Error::input(e.message).at(loc) } else { Error::check(e.message).at(loc) }
     })?;
     if let Some(nc::NoFeed(row)) = no_feed {
         return Err(Error::input("no feed for this move: give the f column or --feed")
-            .at(Location::file(file).line(rows[row].line).field("f")));
+            .at(Location::file(file).line(view.get(row).line).field("f")));
+    }
+    if let Some(e) = failed {
+        return Err(spool_error(e));
     }
     let (text, written) = writer.finish();
-    let check = check_text(&text, rows, machine, chain, s.tol)?;
-    judge(&check, rows, machine, s)?;
-    Ok(Posted { text, plan: stats, written, check, tol_used: opts.tol })
+    spool.write_all(&text).map_err(spool_error)?;
+    let program = spool.finish().map_err(spool_error)?;
+    let check = check_program(&program, rows, machine, chain, s)?;
+    judge(&check, &view, machine, s)?;
+    Ok(Posted { program, plan: stats, written, check, tol_used: opts.tol })
 }
+
+/// Bytes of program text the writer holds before they go to the spool.
+const SPOOL_BYTES: usize = 1 << 16;
 
 /// The verdict on a program read back: a check failure (exit 1) naming where it misses if the tip,
 /// the axis (anywhere, also in the singular cone) or the spindle orientation is beyond its
 /// tolerance.
-pub fn judge(check: &readback::Deviation, rows: &[Cl], machine: &Machine, s: &Settings) -> Result<()> {
+pub fn judge<R: Get<Cl> + ?Sized>(
+    check: &readback::Deviation,
+    rows: &R,
+    machine: &Machine,
+    s: &Settings,
+) -> Result<()> {
     if !camkit::tol::within(check.tip, s.tol) || !camkit::tol::within(check.coverage, s.tol) {
         return Err(Error::check(format!(
             "read back, the program deviates {:.6} mm from the CL (at NC line {}; rows {:.6} mm, at input line {}): more than --tol {} mm",
-            check.tip, check.tip_line, check.coverage, rows[check.coverage_row].line, s.tol
+            check.tip,
+            check.tip_line,
+            check.coverage,
+            rows.get(check.coverage_row).line,
+            s.tol
         )));
     }
-    let over = |d: f64| d > s.angle_tol * (1.0 + 1e-6) + 1e-9;
-    if over(check.axis_deg) {
-        let beyond: Vec<usize> = (0..rows.len()).filter(|&i| over(check.row_axis_deg[i])).collect();
+    if readback::axis_beyond(check.axis_deg, s.angle_tol) {
         return Err(Error::check(format!(
             "read back, the tool axis deviates {:.5}° from the CL (NC line {}, rows at input lines {}): more than \
              --angle-tol {}°",
             check.axis_deg,
             check.axis_line,
-            lines_of(rows, &beyond),
+            lines_of(rows, &check.axis_rows),
             s.angle_tol
         )));
     }
@@ -325,30 +356,49 @@ pub fn judge(check: &readback::Deviation, rows: &[Cl], machine: &Machine, s: &Se
 }
 
 /// Input lines of rows (indices), as a short list: the first few and how many more.
-fn lines_of(rows: &[Cl], at: &[usize]) -> String {
-    let shown: Vec<String> = at.iter().take(8).map(|&i| rows[i].line.to_string()).collect();
+fn lines_of<R: Get<Cl> + ?Sized>(rows: &R, at: &[usize]) -> String {
+    let shown: Vec<String> = at.iter().take(8).map(|&i| rows.get(i).line.to_string()).collect();
     match at.len() {
         n if n > shown.len() => format!("{} and {} more", shown.join(", "), n - shown.len()),
         _ => shown.join(", "),
     }
 }
 
-/// Reads a program text back and compares it with the rows.
-pub fn check_text(text: &[u8], rows: &[Cl], machine: &Machine, chain: &Chain, tol: f64) -> Result<readback::Deviation> {
-    let text = std::str::from_utf8(text).map_err(|_| Error::runtime("the written program is not UTF-8"))?;
-    let program = read_axes("written program", text)
-        .map_err(|e| Error::runtime(format!("the written program does not read back: {e}")))?;
+/// Reads a written program back from its spool and compares it with the rows.
+pub fn check_program<R: Share<Cl> + ?Sized>(
+    program: &Spooled,
+    rows: &R,
+    machine: &Machine,
+    chain: &Chain,
+    s: &Settings,
+) -> Result<readback::Deviation> {
+    let open = || Box::new(program.reader()) as Box<dyn std::io::BufRead + '_>;
+    let program = readback::Program { open: &open, name: "written program" };
     let reading = readback::Reading::new(machine, chain);
-    let poses = readback::poses(&program, &reading);
-    drop(program);
-    Ok(readback::verify(rows, &poses, &reading, CHECK_SAMPLES, tol))
+    readback::verify(rows, program, &reading, CHECK_SAMPLES, s.tol, s.angle_tol)
+        .map_err(|e| Error::runtime(format!("the written program does not read back: {e}")))
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use camkit::gcode::read_axes;
     use camkit::geom::{P3, V3};
     use proptest::prelude::*;
+    use std::io::Read;
+
+    /// The text of a posted program.
+    fn text_of(p: &Posted) -> String {
+        let mut text = String::new();
+        p.program.reader().read_to_string(&mut text).unwrap();
+        text
+    }
+
+    /// [`readback::verify`] on a program's text (--angle-tol 0.05°).
+    fn verify_text(rows: &[Cl], text: &str, r: &readback::Reading, samples: usize, tol: f64) -> readback::Deviation {
+        let open = || Box::new(text.as_bytes()) as Box<dyn std::io::BufRead + '_>;
+        readback::verify(rows, readback::Program { open: &open, name: "t" }, r, samples, tol, 0.05).unwrap()
+    }
 
     fn machine(name: &str) -> (Machine, Chain) {
         let path = format!("{}/../../data/post-6axis/{name}", env!("CARGO_MANIFEST_DIR"));
@@ -385,10 +435,8 @@ mod tests {
             let s = Settings { tol: 0.002, ..Settings::default() };
             let posted = post(&rows, "t", &m, &chain, &s, vec![]).expect("posts");
             prop_assert!(posted.check.tip <= 0.002 && posted.check.coverage <= 0.002, "{:?}", posted.check);
-            let text = std::str::from_utf8(&posted.text).unwrap();
-            let program = read_axes("t", text).unwrap();
             let reading = readback::Reading::new(&m, &chain);
-            let dense = readback::verify(&rows, &readback::poses(&program, &reading), &reading, 4 * CHECK_SAMPLES, 0.002);
+            let dense = verify_text(&rows, &text_of(&posted), &reading, 4 * CHECK_SAMPLES, 0.002);
             prop_assert!(dense.tip <= 0.002 * (1.0 + 1e-9), "dense check {:?}", dense);
             prop_assert!(dense.axis_deg <= 0.05 * (1.0 + 1e-6) + 1e-9, "{:?}", dense);
         }
@@ -403,9 +451,8 @@ mod tests {
         let rows = pass(60, 54.5, 152.0, 5.73, false);
         let s = Settings { tol: 0.002, ..Settings::default() };
         let posted = post(&rows, "t", &m, &chain, &s, vec![]).expect("posts");
-        let program = read_axes("t", std::str::from_utf8(&posted.text).unwrap()).unwrap();
         let reading = readback::Reading::new(&m, &chain);
-        let dense = readback::verify(&rows, &readback::poses(&program, &reading), &reading, 4 * CHECK_SAMPLES, 0.002);
+        let dense = verify_text(&rows, &text_of(&posted), &reading, 4 * CHECK_SAMPLES, 0.002);
         assert!(
             posted.check.axis_deg <= 0.05 && dense.axis_deg <= 0.05,
             "{} {}",
@@ -437,7 +484,7 @@ mod tests {
             }
         }
         let posted = post(&rows, "t", &m, &chain, &Settings::default(), vec![]).expect("posts");
-        let program = read_axes("t", std::str::from_utf8(&posted.text).unwrap()).unwrap();
+        let program = read_axes("t", &text_of(&posted)).unwrap();
         let b_max = program.moves.iter().map(|mv| mv.pos[4].abs()).fold(0.0, f64::max);
         assert!(b_max > 350.0 && b_max < 720.0, "B continuous within a pass, unwound between: {b_max}");
         assert_eq!(posted.plan.spindle_unwinds, 3, "{:?}", posted.plan);
@@ -462,9 +509,7 @@ mod tests {
         let mut off = posted.check.clone();
         off.axis_deg = 0.3;
         off.axis_line = 42;
-        for i in [3, 4, 9] {
-            off.row_axis_deg[i] = 0.3;
-        }
+        off.axis_rows = vec![3, 4, 9];
         let e = judge(&off, &rows, &m, &s).unwrap_err();
         assert_eq!(e.kind, camkit::error::ErrorKind::Check, "{e}");
         assert!(e.to_string().contains("NC line 42, rows at input lines 5, 6, 11"), "{e}");
@@ -487,7 +532,10 @@ mod tests {
             assert!(stats.inserted > 0, "{name}: {stats:?}");
             let wopts = nc::WriteOptions { rotary_radius: s.rotary_radius, comments: vec!["c".into()] };
             let (whole, _) = nc::write(&steps, &m, &chain, &wopts).expect("writes");
-            assert!(posted.text == whole, "{name}: the streamed program differs from the whole plan written");
+            assert!(
+                text_of(&posted).as_bytes() == whole,
+                "{name}: the streamed program differs from the whole plan written"
+            );
             assert_eq!(posted.plan, stats, "{name}");
         }
     }
@@ -502,10 +550,31 @@ mod tests {
         assert!(posted.check.blocks > 2 * readback::CHUNK, "{:?}", posted.check);
         let on = |threads: usize| {
             let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
-            pool.install(|| check_text(&posted.text, &rows, &m, &chain, Settings::default().tol).unwrap())
+            pool.install(|| check_program(&posted.program, &rows, &m, &chain, &Settings::default()).unwrap())
         };
         assert_eq!(on(1), posted.check);
         assert_eq!(on(4), posted.check);
+    }
+
+    /// Rows on disk post as the same rows in memory do: the same program byte for byte and the
+    /// same read-back figures, over more rows than a page of records and a chunk of the check
+    /// hold (the records read back bit for bit).
+    #[test]
+    fn rows_on_disk_post_as_rows_in_memory() {
+        let (m, chain) = machine("paper000-sixaxis-b.json");
+        let rows = pass(readback::CHUNK + 700, 30.0, 90.0, 2.0, true);
+        let mut spool = camkit::io::RecordSpool::new();
+        for r in &rows {
+            spool.push(r);
+        }
+        let disk = spool.finish();
+        assert!(disk.iter().zip(&rows).all(|(a, b)| a == *b) && disk.len() == rows.len());
+        let s = Settings::default();
+        let (a, b) =
+            (post(&rows, "t", &m, &chain, &s, vec![]).unwrap(), post(&disk, "t", &m, &chain, &s, vec![]).unwrap());
+        assert!(text_of(&a) == text_of(&b), "the programs differ");
+        assert!(a.program.len() > 1 << 17, "{} bytes", a.program.len());
+        assert_eq!((a.check, a.plan, a.written), (b.check, b.plan, b.written));
     }
 
     #[test]
@@ -526,7 +595,7 @@ mod tests {
         let (m, chain) = machine("paper002-ac.json");
         let rows = pass(30, 30.0, 90.0, 1.0, false);
         let posted = post(&rows, "t", &m, &chain, &Settings::default(), vec![]).expect("posts");
-        let text = String::from_utf8(posted.text).unwrap();
+        let text = text_of(&posted);
         let program = read_axes("t", &text).unwrap();
         let reading = readback::Reading::new(&m, &chain);
         let table = readback::reverse(&readback::poses(&program, &reading), &reading);
@@ -567,7 +636,7 @@ mod tests {
         let mut off = rows;
         off[2].axis = tilt(23.0);
         off[3].axis = tilt(23.0);
-        let check = check_text(&posted.text, &off, &m, &chain, 0.005).unwrap();
+        let check = check_program(&posted.program, &off, &m, &chain, &Settings::default()).unwrap();
         assert!((check.axis_deg - 1.0).abs() < 0.01, "{check:?}");
     }
 
@@ -597,13 +666,13 @@ mod tests {
         let posted = post(&rows, "t", &m, &chain, &Settings::default(), vec![]).expect("posts");
         // C turns −360° per pass (sense −1): from 90° to −270°, −270° to −630°, then unwound to 90°.
         assert_eq!(posted.plan.unwinds, 1, "{:?}", posted.plan);
-        let program = read_axes("t", std::str::from_utf8(&posted.text).unwrap()).unwrap();
+        let program = read_axes("t", &text_of(&posted)).unwrap();
         let c_max = program.moves.iter().map(|mv| mv.pos[5].abs()).fold(0.0, f64::max);
         assert!(c_max > 600.0 && c_max < 720.0, "C stays continuous within a pass, unwound between: {c_max}");
         m.program.units = camkit::doc::machine::UnitsDoc::Inch;
         m.program.decimals.linear = 5;
         let inch = post(&rows, "t", &m, &chain, &Settings::default(), vec![]).expect("posts in inches");
-        assert!(std::str::from_utf8(&inch.text).unwrap().contains("G20 "));
+        assert!(text_of(&inch).contains("G20 "));
         assert!(inch.check.tip <= 0.005, "{:?}", inch.check);
     }
 }

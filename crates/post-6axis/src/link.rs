@@ -68,7 +68,9 @@ pub struct Linked {
     pub stats: Stats,
 }
 
-/// Everything linking needs besides the rows.
+/// Everything linking needs besides the rows, and the rows on their way through: linking takes
+/// the rows one at a time ([`Linker::push`]), holds the [`RAMP_ROWS`] after the one it links (a
+/// ramp's stretch), and hands the linked rows over as it makes them ([`Linker::take`]).
 pub struct Linker<'a> {
     job: &'a Job,
     walls: Option<&'a Walls>,
@@ -77,7 +79,14 @@ pub struct Linker<'a> {
     map: Material,
     file: &'a str,
     stats: Stats,
+    /// Linked rows not yet taken.
     out: Vec<Cl>,
+    /// The last two rows linked (the last one last).
+    tail: [Option<Cl>; 2],
+    /// Rows waiting for the rows after them.
+    ahead: std::collections::VecDeque<Cl>,
+    /// Rows linked so far.
+    seen: usize,
 }
 
 fn xy(p: &P3) -> P2 {
@@ -179,7 +188,21 @@ impl<'a> Linker<'a> {
             file,
             stats: Stats::default(),
             out: Vec::new(),
+            tail: [None; 2],
+            ahead: std::collections::VecDeque::new(),
+            seen: 0,
         })
+    }
+
+    /// Appends a linked row.
+    fn emit(&mut self, row: Cl) {
+        self.tail = [self.tail[1], Some(row)];
+        self.out.push(row);
+    }
+
+    /// The last row linked.
+    fn last(&self) -> Option<Cl> {
+        self.tail[1]
     }
 
     fn at(&self, row: &Cl) -> Location {
@@ -255,7 +278,7 @@ impl<'a> Linker<'a> {
     /// the setup's ramp angle need from the material under the start (shorter where the pass stops
     /// being level; at most [`RAMP_ROWS`] rows), descending from the approach distance above the
     /// material under the stretch. `None` where there is no such stretch or nothing to descend.
-    fn ramp(&self, start: &Cl, rest: &[Cl]) -> Option<(P3, Vec<Cl>)> {
+    fn ramp(&self, start: &Cl, rest: impl Iterator<Item = Cl>) -> Option<(P3, Vec<Cl>)> {
         let angle = self.job.ramp_angle?;
         if !vertical(&start.axis) {
             return None;
@@ -269,12 +292,12 @@ impl<'a> Linker<'a> {
         let mut stretch: Vec<(P3, P3, Option<ClArc>)> = Vec::new();
         let mut length = 0.0;
         let mut from = start.tip;
-        for row in rest.iter().take(RAMP_ROWS).take_while(|n| !n.rapid && vertical(&n.axis)) {
+        for row in rest.take(RAMP_ROWS).take_while(|n| !n.rapid && vertical(&n.axis)) {
             let level = (row.tip.z - start.tip.z).abs() <= 1e-9 && row.arc.is_none_or(|a| a.plane == Plane::Xy);
             if !level || length >= want {
                 break;
             }
-            for (seg, ..) in cut_pieces(&from, row) {
+            for (seg, ..) in cut_pieces(&from, &row) {
                 top = top.max(self.map.highest_along(&seg, r));
                 length += seg.length();
             }
@@ -330,8 +353,8 @@ impl<'a> Linker<'a> {
     }
 
     /// Appends the link from the last row written (or the program start) to the pass that starts
-    /// with `start` (`next`: the row after it).
-    fn link_to(&mut self, start: &Cl, rest: &[Cl]) -> Result<()> {
+    /// with `start` (`rest`: the rows after it).
+    fn link_to(&mut self, start: &Cl, rest: impl Iterator<Item = Cl>) -> Result<()> {
         self.stats.links += 1;
         if start.axis.z < LEAST_AXIS_Z {
             return Err(Error::input(format!(
@@ -345,7 +368,7 @@ impl<'a> Linker<'a> {
             Some((top, _)) => *top,
             None => self.approach_point(&start.tip, &start.axis, self.material_under(&start.tip, &start.axis)),
         };
-        let prev = self.out.last().copied();
+        let prev = self.last();
         let (safe, clear) = (self.job.safe_height, self.job.clearance_height);
         let mut height = safe;
         if let Some(end) = &prev {
@@ -367,15 +390,15 @@ impl<'a> Linker<'a> {
             }
             let up = Self::up_to(&end.tip, &end.axis, height);
             if up != end.tip {
-                self.out.push(self.row(up, end, true, None));
+                self.emit(self.row(up, end, true, None));
             }
         }
         let above = Self::up_to(&approach, &start.axis, height);
         let mut traverse = self.row(above, start, true, None);
         traverse.reorient = true;
-        self.out.push(traverse);
+        self.emit(traverse);
         if approach != above {
-            self.out.push(self.row(approach, start, true, None));
+            self.emit(self.row(approach, start, true, None));
         }
         if approach == start.tip {
             self.stats.direct += 1;
@@ -400,7 +423,7 @@ impl<'a> Linker<'a> {
 
     /// Appends a feed row, taking its cut off the map.
     fn feed(&mut self, row: &Cl) {
-        if let Some(prev) = self.out.last()
+        if let Some(prev) = self.last()
             && vertical(&row.axis)
             && vertical(&prev.axis)
         {
@@ -408,7 +431,7 @@ impl<'a> Linker<'a> {
                 self.map.cut(&self.cutter, &seg, z0, z1);
             }
         }
-        self.out.push(Cl { rapid: false, reorient: false, ..*row });
+        self.emit(Cl { rapid: false, reorient: false, ..*row });
     }
 
     /// The vertical tool body measured against the part's walls.
@@ -469,7 +492,7 @@ impl<'a> Linker<'a> {
 
     /// The lead-out from the pass just written, if its last move is level with a vertical tool.
     fn lead_out(&mut self) {
-        let [.., prev, end] = self.out[..] else { return };
+        let [Some(prev), Some(end)] = self.tail else { return };
         if prev.rapid || end.rapid || !vertical(&end.axis) || !vertical(&prev.axis) {
             return;
         }
@@ -480,110 +503,153 @@ impl<'a> Linker<'a> {
         }
     }
 
-    /// Refuses rows that cut outside the stock: below its bottom, or beyond its outline by more
-    /// than the tool radius.
-    fn inside(&self, rows: &[Cl]) -> Result<()> {
-        let (lo, hi) = self.job.stock.extent();
-        let r = self.cutter.radius;
-        for row in rows.iter().filter(|row| !row.rapid) {
-            let p = row.tip;
-            let outside = p.x < lo[0] - r || p.x > hi[0] + r || p.y < lo[1] - r || p.y > hi[1] + r;
-            if outside || p.z < self.job.stock.bottom() {
-                return Err(self.job.error(
-                    "stock",
-                    format!(
-                        "the stock does not contain the toolpath: {}:{} cuts at ({:.4}, {:.4}, {:.4}), {} the stock (x {}..{}, y {}..{}, z {}..{})",
-                        self.file,
-                        row.line,
-                        p.x,
-                        p.y,
-                        p.z,
-                        if outside { "outside" } else { "below" },
-                        lo[0],
-                        hi[0],
-                        lo[1],
-                        hi[1],
-                        self.job.stock.bottom(),
-                        self.job.stock.top()
-                    ),
-                ));
-            }
+    /// Refuses a pass that starts inside the part: the post cannot reach it safely. Rows that
+    /// start no pass pass.
+    pub fn reachable(&self, row: &Cl) -> Result<()> {
+        if !row.rapid {
+            return Ok(());
         }
-        Ok(())
-    }
-
-    /// Refuses a pass that starts inside the part: the post cannot reach it safely.
-    fn reachable(&self, rows: &[Cl]) -> Result<()> {
         if let Some((solid, body)) = self.solid {
-            for row in rows.iter().filter(|r| r.rapid) {
-                let edge = row.s.map(|s| camkit::kinematics::edge_direction(&row.axis, s));
-                let c = solid.clearance(body, &Placement { tip: row.tip, axis: row.axis, edge }, 1.0);
-                if c < self.job.allowance - self.job.tolerance {
-                    return Err(self.job.error(
-                        "part",
-                        format!(
-                            "the pass starting at {}:{} ({:.4}, {:.4}, {:.4}) cannot be reached safely: the tool there comes {c:.4} mm from the part's model (allowance {} mm)",
-                            self.file, row.line, row.tip.x, row.tip.y, row.tip.z, self.job.allowance
-                        ),
-                    ));
-                }
-            }
-        }
-        let Some(walls) = self.walls else { return Ok(()) };
-        let column = self.column();
-        for row in rows.iter().filter(|r| r.rapid && vertical(&r.axis)) {
-            let p = xy(&row.tip);
-            let c = walls.clearance(&column, &Seg::Line(p, p), row.tip.z, row.tip.z).mm;
+            let edge = row.s.map(|s| camkit::kinematics::edge_direction(&row.axis, s));
+            let c = solid.clearance(body, &Placement { tip: row.tip, axis: row.axis, edge }, 1.0);
             if c < self.job.allowance - self.job.tolerance {
                 return Err(self.job.error(
                     "part",
                     format!(
-                        "the pass starting at {}:{} ({:.4}, {:.4}, {:.4}) cannot be reached safely: the tool there comes {c:.4} mm from the part's walls or floor (allowance {} mm)",
+                        "the pass starting at {}:{} ({:.4}, {:.4}, {:.4}) cannot be reached safely: the tool there comes {c:.4} mm from the part's model (allowance {} mm)",
                         self.file, row.line, row.tip.x, row.tip.y, row.tip.z, self.job.allowance
                     ),
                 ));
             }
         }
+        let Some(walls) = self.walls.filter(|_| vertical(&row.axis)) else { return Ok(()) };
+        let p = xy(&row.tip);
+        let c = walls.clearance(&self.column(), &Seg::Line(p, p), row.tip.z, row.tip.z).mm;
+        if c < self.job.allowance - self.job.tolerance {
+            return Err(self.job.error(
+                "part",
+                format!(
+                    "the pass starting at {}:{} ({:.4}, {:.4}, {:.4}) cannot be reached safely: the tool there comes {c:.4} mm from the part's walls or floor (allowance {} mm)",
+                    self.file, row.line, row.tip.x, row.tip.y, row.tip.z, self.job.allowance
+                ),
+            ));
+        }
         Ok(())
     }
 
-    /// Links all `rows` (pass starts are the rows marked `rapid`).
-    pub fn link(mut self, rows: &[Cl]) -> Result<Linked> {
-        self.inside(rows)?;
-        self.reachable(rows)?;
-        for (i, row) in rows.iter().enumerate() {
-            if row.rapid || self.out.is_empty() {
-                if i > 0 {
-                    self.lead_out();
-                }
-                match self.lead_in(row, rows.get(i + 1)) {
-                    Some((start, arc)) => {
-                        // The ramp, if any, runs along the lead-in and on into the pass.
-                        let rest: Vec<Cl> =
-                            std::iter::once(arc).chain(rows[i + 1..].iter().take(RAMP_ROWS).copied()).collect();
-                        self.link_to(&start, &rest)?;
-                        self.feed(&arc);
-                    }
-                    None => self.link_to(row, &rows[i + 1..])?,
-                }
-            } else {
-                self.feed(row);
-            }
+    /// Takes the next row (pass starts are the rows marked `rapid`): linked once the
+    /// [`RAMP_ROWS`] after it have come (or [`Linker::finish`]).
+    pub fn push(&mut self, row: Cl) -> Result<()> {
+        self.ahead.push_back(row);
+        if self.ahead.len() > RAMP_ROWS {
+            self.link_next()?;
         }
-        if !rows.is_empty() {
+        Ok(())
+    }
+
+    /// Links the first row waiting.
+    fn link_next(&mut self) -> Result<()> {
+        let ahead = std::mem::take(&mut self.ahead);
+        let done = self.link_front(&ahead);
+        self.ahead = ahead;
+        self.ahead.pop_front();
+        self.seen += 1;
+        done
+    }
+
+    fn link_front(&mut self, ahead: &std::collections::VecDeque<Cl>) -> Result<()> {
+        let row = ahead[0];
+        let rest = || ahead.iter().skip(1).copied();
+        if row.rapid || self.last().is_none() {
+            if self.seen > 0 {
+                self.lead_out();
+            }
+            match self.lead_in(&row, ahead.get(1)) {
+                Some((start, arc)) => {
+                    // The ramp, if any, runs along the lead-in and on into the pass.
+                    self.link_to(&start, std::iter::once(arc).chain(rest().take(RAMP_ROWS)))?;
+                    self.feed(&arc);
+                }
+                None => self.link_to(&row, rest())?,
+            }
+        } else {
+            self.feed(&row);
+        }
+        Ok(())
+    }
+
+    /// The linked rows made so far, taken out.
+    pub fn take(&mut self) -> std::vec::Drain<'_, Cl> {
+        self.out.drain(..)
+    }
+
+    /// Links the rows still waiting, leads out of the last pass and retracts to the clearance
+    /// height; the figures.
+    pub fn finish(&mut self) -> Result<Stats> {
+        while !self.ahead.is_empty() {
+            self.link_next()?;
+        }
+        if self.seen > 0 {
             self.lead_out();
         }
-        if let Some(end) = self.out.last().copied() {
+        if let Some(end) = self.last() {
             let up = Self::up_to(&end.tip, &end.axis, self.job.clearance_height);
             if up != end.tip {
-                self.out.push(self.row(up, &end, true, None));
+                self.emit(self.row(up, &end, true, None));
             }
         }
-        // Held to the end of the read-back check: without the slack of its doubling growth
-        // (up to a third of it; 4 MB of the 10× mould stream's rows).
-        self.out.shrink_to_fit();
-        Ok(Linked { rows: self.out, stats: self.stats })
+        Ok(self.stats)
     }
+
+    /// Links all `rows` at once: refused if one cuts outside the stock ([`outside_stock`]), then
+    /// if a pass starts inside the part ([`Linker::reachable`]), each the first such row.
+    pub fn link(mut self, rows: &[Cl]) -> Result<Linked> {
+        if let Some(e) = rows.iter().find_map(|row| outside_stock(self.job, self.file, row)) {
+            return Err(e);
+        }
+        for row in rows {
+            self.reachable(row)?;
+        }
+        let mut out = Vec::new();
+        for row in rows {
+            self.push(*row)?;
+            out.extend(self.take());
+        }
+        let stats = self.finish()?;
+        out.extend(self.take());
+        Ok(Linked { rows: out, stats })
+    }
+}
+
+/// The refusal of a row that cuts outside the stock (`file` names the rows): below its bottom,
+/// or beyond its outline by more than the tool radius. Rapid rows are not cuts.
+pub fn outside_stock(job: &Job, file: &str, row: &Cl) -> Option<Error> {
+    if row.rapid {
+        return None;
+    }
+    let (lo, hi) = job.stock.extent();
+    let r = job.tool.radius;
+    let p = row.tip;
+    let outside = p.x < lo[0] - r || p.x > hi[0] + r || p.y < lo[1] - r || p.y > hi[1] + r;
+    (outside || p.z < job.stock.bottom()).then(|| {
+        job.error(
+            "stock",
+            format!(
+                "the stock does not contain the toolpath: {file}:{} cuts at ({:.4}, {:.4}, {:.4}), {} the stock (x {}..{}, y {}..{}, z {}..{})",
+                row.line,
+                p.x,
+                p.y,
+                p.z,
+                if outside { "outside" } else { "below" },
+                lo[0],
+                hi[0],
+                lo[1],
+                hi[1],
+                job.stock.bottom(),
+                job.stock.top()
+            ),
+        )
+    })
 }
 
 #[cfg(test)]

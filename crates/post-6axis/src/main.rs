@@ -8,13 +8,15 @@ use camkit::doc::Setup;
 use camkit::doc::machine::Machine;
 use camkit::doc::setup::{Job, Part};
 use camkit::error::{Error, Location, Result};
-use camkit::gcode::read_axes;
-use camkit::io::{Input, Output, Source, write_atomic};
+use camkit::gcode::{AxisBlocks, read_axes};
+use camkit::io::{Input, Output, RecordSpool, Records, Source, Spooled, Stream, write_atomic};
 use camkit::kinematics::Chain;
 use camkit::report::Report;
 use camkit::table::meaning::{self, Meaning};
 use camkit::table::{self, Col, WriteOptions};
 use clap::Parser;
+use post_6axis::plan::Cl;
+use post_6axis::readback::{NcPose, Program};
 use post_6axis::{ClReader, Settings, collision, judge, link, plot, post, readback};
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -194,12 +196,16 @@ fn run(args: Args) -> Result<()> {
     if let (Some(nc), Some(j)) = (&args.check, &job) {
         let nc_input = Input::open(nc)?;
         let text = nc_input.text()?;
-        read_axes(&nc_input.name, text)?;
+        for block in AxisBlocks::new(&nc_input.name, text.as_bytes()) {
+            block?;
+        }
         report.set("program", &nc_input.name);
         let walls = walls_of(j);
         let solid = solid_of(j)?;
         let parts = (walls.as_ref(), solid.as_ref().map(|(s, b)| (s, b)));
-        let failed = collide(text.as_bytes(), &machine, &chain, j, parts, &args, &mut report);
+        let open = || Box::new(text.as_bytes()) as Box<dyn std::io::BufRead + '_>;
+        let program = Program { open: &open, name: &nc_input.name };
+        let failed = collide(program, &machine, &chain, j, parts, &args, &mut report);
         out.buf = report.to_json().into_bytes();
         finish(out, &args, report)?;
         return failed;
@@ -222,12 +228,16 @@ fn run(args: Args) -> Result<()> {
         table::write(&mut out, &t, &WriteOptions::default())?;
         return finish(out, &args, report);
     }
-    // The rows as CL rows, read as they come from the file (standard input copied to a temporary
-    // file): neither the table's rows nor its text are held.
+    // The first reading: the rows checked as CL rows as they come from the file (standard input
+    // copied to a temporary file), neither the table's rows nor its text held; the rows kept, on
+    // disk, only where no linking follows (that reads them again).
     let input = Source::open(&args.io.input)?;
+    let keep = job.is_none() || args.verify.is_some();
+    let mut given = RecordSpool::<Cl>::new();
+    let mut outside = None;
+    let mut passes = 0;
     let mut meaning = None;
     let mut reader = None;
-    let mut rows = Vec::new();
     let schema = table::read_each_source(&input, &[Col::X, Col::Y], |schema, row| {
         let check = meaning.get_or_insert_with(|| meaning::Check::new(schema));
         check.row(&row, &input.name)?;
@@ -241,11 +251,20 @@ fn run(args: Args) -> Result<()> {
             Some(r) => r,
             None => reader.insert(ClReader::new(schema, &input.name, &chain, &machine, settings.feed, settings.tol)?),
         };
-        rows.push(r.row(&row)?);
+        let cl = r.row(&row)?;
+        if let Some(j) = &job
+            && outside.is_none()
+        {
+            outside = link::outside_stock(j, &input.name, &cl);
+        }
+        passes += usize::from(cl.rapid);
+        if keep {
+            given.push(&cl);
+        }
         Ok(())
     })?;
-    let normalised = match reader {
-        Some(r) => r.normalised,
+    let (normalised, count) = match reader {
+        Some(r) => (r.normalised, r.rows),
         None => {
             ClReader::new(&schema, &input.name, &chain, &machine, settings.feed, settings.tol)?;
             return Err(Error::input("no rows: nothing to post").at(Location::file(&input.name)));
@@ -254,26 +273,32 @@ fn run(args: Args) -> Result<()> {
     if normalised > 0 {
         cli::warn(&format!("{normalised} tool axes were not unit vectors (within 1e-3): normalised"));
     }
+    let given = given.finish();
     if let Some(nc) = &args.verify {
         let nc_input = Input::open(nc)?;
-        let program = read_axes(&nc_input.name, nc_input.text()?)?;
+        let text = nc_input.text()?;
+        let open = || Box::new(text.as_bytes()) as Box<dyn std::io::BufRead + '_>;
+        let program = Program { open: &open, name: &nc_input.name };
         let reading = readback::Reading::new(&machine, &chain);
-        let poses = readback::poses(&program, &reading);
-        if poses.iter().all(Option::is_none) {
+        let mut any = false;
+        for pose in program.poses(&reading) {
+            any |= pose?.is_some();
+        }
+        if !any {
             // Nothing to compare: every row would be "missed" by an infinite distance.
             return Err(Error::input("the program has no motion blocks (in workpiece coordinates, every axis known)")
                 .at(Location::file(&nc_input.name)));
         }
-        let d = readback::verify(&rows, &poses, &reading, 32, settings.tol);
+        let d = readback::verify(&given, program, &reading, 32, settings.tol, settings.angle_tol)?;
         deviation_keys(&mut report, &d);
-        report.set("rows", rows.len()).set("tol_mm", settings.tol).set("angle_tol_deg", settings.angle_tol);
+        report.set("rows", count).set("tol_mm", settings.tol).set("angle_tol_deg", settings.angle_tol);
         out.buf = report.to_json().into_bytes();
         finish(out, &args, report)?;
-        return judge(&d, &rows, &machine, &settings).map_err(|e| Error::check(format!("{nc}: {}", e.message)));
+        return judge(&d, &given.view(), &machine, &settings).map_err(|e| Error::check(format!("{nc}: {}", e.message)));
     }
     let mut comments = vec![
         format!("post-6axis {}: {}", env!("CARGO_PKG_VERSION"), machine.name),
-        format!("{} machine, {} rows from {}", chain.family().name(), rows.len(), input.name),
+        format!("{} machine, {} rows from {}", chain.family().name(), count, input.name),
         format!("tolerance {} mm, {} deg", settings.tol, settings.angle_tol),
     ];
     let walls = job.as_ref().and_then(walls_of);
@@ -283,8 +308,11 @@ fn run(args: Args) -> Result<()> {
     let progress = args.io.progress(0, "linking the passes");
     let rows = match &job {
         Some(j) => {
-            let linked = link::Linker::new(j, walls.as_ref(), solid_ref, &input.name)?.link(&rows)?;
-            drop(rows);
+            let linker = link::Linker::new(j, walls.as_ref(), solid_ref, &input.name)?;
+            if let Some(e) = outside {
+                return Err(e);
+            }
+            let (linked, stats) = link_rows(&input, linker, &chain, &machine, &settings)?;
             report.set("link_seconds", link_started.elapsed().as_secs_f64());
             comments.push(format!(
                 "setup {}: tool T{} from {}, clearance Z{} safe Z{} approach {} mm",
@@ -295,17 +323,16 @@ fn run(args: Args) -> Result<()> {
                 j.safe_height,
                 j.approach
             ));
-            link_keys(&mut report, &linked.stats);
-            linked.rows
+            link_keys(&mut report, &stats);
+            linked
         }
-        None => rows,
+        None => given,
     };
     let post_started = Instant::now();
     progress.stage(0, "writing the program");
     let posted = post(&rows, &input.name, &machine, &chain, &settings, comments)?;
     progress.finish();
     report.set("post_seconds", post_started.elapsed().as_secs_f64());
-    let passes = rows.iter().filter(|r| r.rapid).count();
     // The collision check and the plot read the written program: the rows are done with.
     let row_count = rows.len();
     drop(rows);
@@ -314,18 +341,17 @@ fn run(args: Args) -> Result<()> {
             "{passes} passes joined by straight G0 moves as given, not linked or checked against the stock: give --setup"
         ));
     }
+    let open = || Box::new(posted.program.reader()) as Box<dyn std::io::BufRead + '_>;
+    let program = Program { open: &open, name: "written program" };
     if let Some(j) = &job {
-        collide(&posted.text, &machine, &chain, j, (walls.as_ref(), solid_ref), &args, &mut report)?;
+        collide(program, &machine, &chain, j, (walls.as_ref(), solid_ref), &args, &mut report)?;
     }
     if let Some(path) = &args.svg {
-        let text = std::str::from_utf8(&posted.text).map_err(|_| Error::runtime("the written program is not UTF-8"))?;
-        let program = read_axes("written program", text)?;
         let reading = readback::Reading::new(&machine, &chain);
-        let poses = readback::poses(&program, &reading);
-        let title = format!("{} posted for {}: {} blocks", input.name, machine.name, program.moves.len());
+        let poses = program.poses(&reading).collect::<Result<Vec<Option<NcPose>>>>()?;
+        let title = format!("{} posted for {}: {} blocks", input.name, machine.name, poses.len());
         write_atomic(path, plot::plot(&title, &poses, &reading).to_svg(1200.0).as_bytes())?;
     }
-    out.buf = posted.text;
     if posted.plan.singular_rows > 0 {
         cli::warn(&format!(
             "{} rows lie within {}° of the primary rotary axis: its angle was {} there (largest axis error {:.4}°)",
@@ -354,7 +380,54 @@ fn run(args: Args) -> Result<()> {
         .set("angle_tol_deg", settings.angle_tol);
     deviation_keys(&mut report, &posted.check);
     report.set("seconds", seconds).set("rows_per_second", row_count as f64 / seconds.max(1e-9));
-    finish(out, &args, report)
+    deliver(&posted.program, &args, report)
+}
+
+/// The second reading: the rows read again and linked as they come, the linked rows onto disk.
+/// A pass that starts inside the part is refused (the first) before any fault of linking.
+fn link_rows(
+    input: &Source,
+    mut linker: link::Linker,
+    chain: &Chain,
+    machine: &Machine,
+    settings: &Settings,
+) -> Result<(Records<Cl>, link::Stats)> {
+    let mut linked = RecordSpool::<Cl>::new();
+    let mut reader = None;
+    let (mut unreachable, mut failed) = (None, None);
+    table::read_each_source(input, &[Col::X, Col::Y], |schema, row| {
+        let r = match &mut reader {
+            Some(r) => r,
+            None => reader.insert(ClReader::new(schema, &input.name, chain, machine, settings.feed, settings.tol)?),
+        };
+        let cl = r.row(&row)?;
+        if unreachable.is_none() {
+            unreachable = linker.reachable(&cl).err();
+        }
+        if failed.is_none() {
+            match linker.push(cl) {
+                Ok(()) => linker.take().for_each(|row| linked.push(&row)),
+                Err(e) => failed = Some(e),
+            }
+        }
+        Ok(())
+    })?;
+    if let Some(e) = unreachable.or(failed) {
+        return Err(e);
+    }
+    let stats = linker.finish()?;
+    linker.take().for_each(|row| linked.push(&row));
+    Ok((linked.finish(), stats))
+}
+
+/// Delivers the written program (copied from its spool into the output) and the report.
+fn deliver(program: &Spooled, args: &Args, report: Report) -> Result<()> {
+    if let Some(path) = &args.io.report {
+        report.write(path)?;
+    }
+    let mut out = Stream::new(args.io.output.as_deref())?;
+    std::io::copy(&mut program.reader(), &mut out).map_err(|e| Error::io(e, "cannot write the program"))?;
+    out.commit()
 }
 
 fn link_keys(report: &mut Report, s: &link::Stats) {
@@ -400,7 +473,7 @@ fn solid_of(job: &Job) -> Result<Option<(Solid, Body)>> {
 type Parts<'a> = (Option<&'a Walls>, Option<(&'a Solid, &'a Body)>);
 
 fn collide(
-    text: &[u8],
+    program: Program,
     machine: &Machine,
     chain: &Chain,
     job: &Job,
@@ -408,19 +481,20 @@ fn collide(
     args: &Args,
     report: &mut Report,
 ) -> Result<()> {
-    let text = std::str::from_utf8(text).map_err(|_| Error::runtime("the written program is not UTF-8"))?;
-    let program = read_axes("written program", text)?;
     let reading = readback::Reading::new(machine, chain);
-    let poses = readback::poses(&program, &reading);
-    drop(program);
+    let mut blocks = 0u64;
+    for pose in program.poses(&reading) {
+        pose?;
+        blocks += 1;
+    }
     let check = collision::Check { job, walls, solid };
     let started = Instant::now();
-    let progress = args.io.progress(poses.len() as u64, "checking against the stock");
-    let mut o = check.run(&poses, &reading, &|| progress.inc(1)).map_err(Error::runtime)?;
+    let progress = args.io.progress(blocks, "checking against the stock");
+    let mut o = check.run(program.poses(&reading), &reading, &|| progress.inc(1))?;
     report.set("material_check_seconds", started.elapsed().as_secs_f64());
     let started = Instant::now();
-    progress.stage(if solid.is_some() { poses.len() as u64 } else { 0 }, "checking against the part");
-    let so = check.run_solid(&poses, &reading, job.resolution, &|| progress.inc(1));
+    progress.stage(if solid.is_some() { blocks } else { 0 }, "checking against the part");
+    let so = check.run_solid(program.poses(&reading), &reading, job.resolution, &|| progress.inc(1))?;
     progress.finish();
     report.set("part_check_seconds", started.elapsed().as_secs_f64());
     let low = |a: Option<(f64, u32)>, b: Option<(f64, u32)>| match (a, b) {

@@ -388,7 +388,20 @@ impl<'a> Writer<'a> {
         Ok(())
     }
 
-    /// Writes the footer: the program text and its figures.
+    /// Bytes of text written and not yet taken ([`Writer::write_text`]).
+    pub fn pending(&self) -> usize {
+        self.o.text.len()
+    }
+
+    /// Passes the text of the blocks written so far (whole lines) on to `out` and forgets it: a
+    /// caller that does so as the blocks come never holds the program.
+    pub fn write_text(&mut self, out: &mut impl std::io::Write) -> std::io::Result<()> {
+        out.write_all(&self.o.text)?;
+        self.o.text.clear();
+        Ok(())
+    }
+
+    /// Writes the footer: the rest of the program text and its figures.
     pub fn finish(self) -> (Vec<u8>, Written) {
         let p = &self.machine.program;
         let (mut o, stats, retract, inverse_time) = (self.o, self.stats, self.retract, self.state.inverse_time);

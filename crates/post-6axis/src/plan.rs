@@ -4,9 +4,12 @@
 //! passes), then blocks inserted until the controller's linear interpolation of every axis keeps the
 //! tool tip within `tol` of the straight CL segment and the tool axis within `angle_tol` of the CL's.
 
+use crate::branch::Choices;
 use camkit::geom::dist::point_arc;
 use camkit::geom::{Arc2, P2, P3, Plane, V3};
-use camkit::kinematics::{Chain, Choice, Joints, M3, Solver, principal_deg};
+use camkit::io::spool::{Put, Take};
+use camkit::io::{Get, Record};
+use camkit::kinematics::{Chain, Joints, M3, Solver, principal_deg};
 
 /// An arc of the toolpath in the workpiece frame: from the previous row's tip to this row's,
 /// about `centre` (in the plane's (u, v) coordinates, [`Plane::split`]), turning counter-clockwise
@@ -98,6 +101,39 @@ pub struct Cl {
     pub line: u64,
     /// The row is reached along an arc from the previous row.
     pub arc: Option<ClArc>,
+}
+
+/// A CL row on disk: every field bit for bit.
+impl Record for Cl {
+    const SIZE: usize = 6 * 8 + 2 * 9 + 8 + 16 + 3;
+    fn put(&self, out: &mut Put) {
+        out.f64(self.tip.x).f64(self.tip.y).f64(self.tip.z);
+        out.f64(self.axis.x).f64(self.axis.y).f64(self.axis.z);
+        out.opt_f64(self.s).opt_f64(self.feed).u64(self.line);
+        let arc = self.arc.unwrap_or(ClArc { plane: Plane::Xy, centre: P2::origin(), ccw: false });
+        out.f64(arc.centre.x).f64(arc.centre.y);
+        let plane = match arc.plane {
+            Plane::Xy => 0,
+            Plane::Xz => 1,
+            Plane::Yz => 2,
+        };
+        let flags = u8::from(self.rapid) | u8::from(self.reorient) << 1 | u8::from(self.arc.is_some()) << 2;
+        out.u8(flags).u8(plane).u8(u8::from(arc.ccw));
+    }
+    fn take(bytes: &mut Take) -> Self {
+        let tip = P3::new(bytes.f64(), bytes.f64(), bytes.f64());
+        let axis = V3::new(bytes.f64(), bytes.f64(), bytes.f64());
+        let (s, feed, line) = (bytes.opt_f64(), bytes.opt_f64(), bytes.u64());
+        let centre = P2::new(bytes.f64(), bytes.f64());
+        let (flags, plane, ccw) = (bytes.u8(), bytes.u8(), bytes.u8() != 0);
+        let plane = match plane {
+            1 => Plane::Xz,
+            2 => Plane::Yz,
+            _ => Plane::Xy,
+        };
+        let arc = (flags & 4 != 0).then_some(ClArc { plane, centre, ccw });
+        Cl { tip, axis, s, feed, rapid: flags & 1 != 0, reorient: flags & 2 != 0, line, arc }
+    }
 }
 
 /// How the spindle orientation is commanded, for planning.
@@ -304,7 +340,12 @@ fn lerp_joints(a: &Joints, b: &Joints, t: f64) -> Joints {
 
 /// The sequence of solutions [`crate::branch::choose`] finds for every row, the primary angle
 /// interpolated through singular runs.
-fn choices(rows: &[Cl], m: &Machine, opts: &Options, stats: &mut Stats) -> Result<Vec<Choice>, PlanError> {
+fn choices<R: Get<Cl> + ?Sized>(
+    rows: &R,
+    m: &Machine,
+    opts: &Options,
+    stats: &mut Stats,
+) -> Result<Choices, PlanError> {
     let chosen = crate::branch::choose(rows, m, opts)?;
     stats.unwinds += chosen.unwinds;
     let mut choices = chosen.choices;
@@ -317,16 +358,17 @@ fn choices(rows: &[Cl], m: &Machine, opts: &Options, stats: &mut Stats) -> Resul
 /// The pose of every row in order, before linearisation, handed to `each`: its chosen solution,
 /// the spindle orientation continuous within a pass and unwound where the rotary axes may turn
 /// freely. Figures are counted in `stats` if given.
-fn poses(
-    rows: &[Cl],
-    choices: &[Choice],
+fn poses<R: Get<Cl> + ?Sized>(
+    rows: &R,
+    choices: &mut Choices,
     m: &Machine,
     opts: &Options,
     mut stats: Option<&mut Stats>,
     mut each: impl FnMut(Step) -> Result<(), PlanError>,
 ) -> Result<(), PlanError> {
     let mut sigma: Option<f64> = None;
-    for (i, (row, c)) in rows.iter().zip(choices).enumerate() {
+    for i in 0..rows.len() {
+        let (row, c) = (rows.get(i), choices.get(i));
         let (xyz, frame) = m.linear(&row.tip, &c.rot, opts.tcp);
         m.check_travel(&xyz).map_err(|message| PlanError { row: i, message, unreachable: true })?;
         let joints = Joints { xyz, rot: c.rot };
@@ -349,7 +391,7 @@ fn poses(
         each(Step {
             joints,
             spindle: if row.s.is_some() { sigma } else { None },
-            cl: *row,
+            cl: row,
             row: i,
             inserted: false,
             singular: c.singular,
@@ -362,25 +404,26 @@ fn poses(
 /// Inside each run of singular rows of a pass, the primary angle goes linearly (by tip path
 /// length) from its value where the pass enters the cone to its value where it leaves; a run at
 /// the start or end of a pass takes the value of its one non-singular neighbour.
-fn interpolate_singular_runs(
-    rows: &[Cl],
+fn interpolate_singular_runs<R: Get<Cl> + ?Sized>(
+    rows: &R,
     m: &Machine,
     opts: &Options,
-    choices: &mut [camkit::kinematics::Choice],
+    choices: &mut Choices,
 ) -> Result<(), PlanError> {
     let mut i = 0;
     while i < rows.len() {
-        if !choices[i].singular {
+        if !choices.get(i).singular {
             i += 1;
             continue;
         }
         let start = i;
-        while i < rows.len() && choices[i].singular && (i == start || !rows[i].rapid) {
+        while i < rows.len() && choices.get(i).singular && (i == start || !rows.get(i).rapid) {
             i += 1;
         }
         let end = i; // exclusive
-        let before = (start > 0 && !rows[start].rapid).then(|| choices[start - 1].rot[0]);
-        let after = (end < rows.len() && !rows[end].rapid && !choices[end].singular).then(|| choices[end].rot[0]);
+        let before = (start > 0 && !rows.get(start).rapid).then(|| choices.get(start - 1).rot[0]);
+        let after =
+            (end < rows.len() && !rows.get(end).rapid && !choices.get(end).singular).then(|| choices.get(end).rot[0]);
         let (from, to) = match (before, after) {
             (Some(b), Some(a)) if opts.interpolate_singular => (b, a),
             (Some(b), _) => (b, b),
@@ -391,28 +434,30 @@ fn interpolate_singular_runs(
         let first = if before.is_some() { start - 1 } else { start };
         let last = if after.is_some() { end } else { end - 1 };
         for k in first + 1..=last {
-            let l = lengths.last().copied().unwrap_or(0.0) + (rows[k].tip - rows[k - 1].tip).norm();
+            let l = lengths.last().copied().unwrap_or(0.0) + (rows.get(k).tip - rows.get(k - 1).tip).norm();
             lengths.push(l);
         }
         let total = lengths.last().copied().unwrap_or(0.0);
-        let mut prev = choices[first].rot;
+        let mut prev = choices.get(first).rot;
         let mut run = Vec::with_capacity(end - start);
         for k in start..end {
             let t = if total > 0.0 { lengths[k - first] / total } else { 0.5 };
             let primary = from + (to - from) * t;
             // A row the interpolated primary would leave beyond tolerance keeps the run held.
-            let Ok(c) = crate::branch::held(m, opts, &rows[k].axis, primary, &prev) else { break };
+            let Ok(c) = crate::branch::held(m, opts, &rows.get(k).axis, primary, &prev) else { break };
             run.push(c);
             prev = c.rot;
         }
         if run.len() < end - start {
             continue;
         }
-        choices[start..end].copy_from_slice(&run);
+        for (k, c) in run.iter().enumerate() {
+            choices.set(start + k, c);
+        }
         // The row leaving the cone was chosen from the held value; keep it continuous with the
         // interpolated run.
         if after.is_some() {
-            let c = &mut choices[end];
+            let mut c = choices.get(end);
             c.rot[1] = prev[1] + principal_deg(c.rot[1] - prev[1]);
             let limit_ok = m.chain().rotaries()[1].admits(c.rot[1]);
             if !limit_ok {
@@ -422,6 +467,7 @@ fn interpolate_singular_runs(
                     unreachable: true,
                 });
             }
+            choices.set(end, &c);
         }
     }
     Ok(())
@@ -690,12 +736,17 @@ fn linearise(
 /// next row's blocks no longer depend on it (the last block planned is where linearisation of
 /// the next segment starts): never the whole program's blocks at once. Every pose is checked
 /// against the travel limits before the first block is planned.
-pub fn plan_each(rows: &[Cl], m: &Machine, opts: &Options, emit: &mut dyn FnMut(&Step)) -> Result<Stats, PlanError> {
+pub fn plan_each<R: Get<Cl> + ?Sized>(
+    rows: &R,
+    m: &Machine,
+    opts: &Options,
+    emit: &mut dyn FnMut(&Step),
+) -> Result<Stats, PlanError> {
     let mut stats = Stats { rows: rows.len(), ..Stats::default() };
-    let choices = choices(rows, m, opts, &mut stats)?;
-    poses(rows, &choices, m, opts, Some(&mut stats), |_| Ok(()))?;
+    let mut choices = choices(rows, m, opts, &mut stats)?;
+    poses(rows, &mut choices, m, opts, Some(&mut stats), |_| Ok(()))?;
     let mut out: Vec<Step> = Vec::new();
-    poses(rows, &choices, m, opts, None, |step| {
+    poses(rows, &mut choices, m, opts, None, |step| {
         match out.last().copied() {
             Some(a) if !step.cl.rapid => match &step.cl.arc {
                 Some(arc) => plan_arc(m, opts, &a, &step, arc, &mut out, &mut stats)?,
@@ -712,7 +763,7 @@ pub fn plan_each(rows: &[Cl], m: &Machine, opts: &Options, emit: &mut dyn FnMut(
 }
 
 /// Plans the blocks for CL rows on a machine.
-pub fn plan(rows: &[Cl], m: &Machine, opts: &Options) -> Result<(Vec<Step>, Stats), PlanError> {
+pub fn plan<R: Get<Cl> + ?Sized>(rows: &R, m: &Machine, opts: &Options) -> Result<(Vec<Step>, Stats), PlanError> {
     let mut out = Vec::with_capacity(rows.len() + rows.len() / 8);
     let stats = plan_each(rows, m, opts, &mut |s| out.push(*s))?;
     Ok((out, stats))

@@ -5,12 +5,17 @@
 
 use crate::plan::{Cl, point_segment, slerp, vector_arc};
 use camkit::doc::machine::{Machine, SpindleMode};
-use camkit::gcode::{AXIS_LETTERS, AxisArc, AxisProgram, Motion};
+use camkit::error::Result;
+use camkit::gcode::{AXIS_LETTERS, AxisArc, AxisBlocks, AxisMove, AxisProgram, Motion};
 use camkit::geom::arc::PreparedArc;
 use camkit::geom::{P2, P3, Plane, V3};
+use camkit::io::{Get, RecordSpool, Share};
 use camkit::kinematics::{Chain, Joints, principal_deg};
 use camkit::table::{Col, Move, Row, Schema, Table};
 use rayon::prelude::*;
+use std::cell::RefCell;
+use std::collections::HashMap;
+use std::io::BufRead;
 
 /// How to read a program for one machine.
 #[derive(Clone, Debug)]
@@ -57,40 +62,69 @@ pub struct NcPose {
     pub feed: Option<f64>,
 }
 
-/// The motion blocks of a program as poses; `None` for blocks in machine coordinates (G53) or
-/// before every axis the machine needs has a known position.
-pub fn poses(prog: &AxisProgram, r: &Reading) -> Vec<Option<NcPose>> {
-    let mut sigma_axis_seen = false;
-    prog.moves
-        .iter()
-        .map(|m| {
-            let needed = (0..3).chain(r.rotary_at.iter().copied());
-            if m.machine_coords || needed.clone().any(|k| !m.known[k]) {
-                return None;
+/// Turns motion blocks into poses one at a time: `None` for blocks in machine coordinates (G53)
+/// or before every axis the machine needs has a known position.
+#[derive(Clone, Debug, Default)]
+pub struct PoseOf {
+    sigma_axis_seen: bool,
+}
+
+impl PoseOf {
+    /// The pose of the next block.
+    pub fn pose(&mut self, m: &AxisMove, r: &Reading) -> Option<NcPose> {
+        let needed = (0..3).chain(r.rotary_at.iter().copied());
+        if m.machine_coords || needed.clone().any(|k| !m.known[k]) {
+            return None;
+        }
+        let mut rot = [0.0; 2];
+        for (k, &at) in r.rotary_at.iter().enumerate() {
+            rot[k] = m.pos[at];
+        }
+        let sigma = match r.spindle {
+            Some((SpindleMode::Axis, Some(at), ..)) => {
+                self.sigma_axis_seen |= m.known[at];
+                self.sigma_axis_seen.then_some(m.pos[at])
             }
-            let mut rot = [0.0; 2];
-            for (k, &at) in r.rotary_at.iter().enumerate() {
-                rot[k] = m.pos[at];
-            }
-            let sigma = match r.spindle {
-                Some((SpindleMode::Axis, Some(at), ..)) => {
-                    sigma_axis_seen |= m.known[at];
-                    sigma_axis_seen.then_some(m.pos[at])
-                }
-                Some((SpindleMode::M19, ..)) => m.orient,
-                _ => None,
-            };
-            Some(NcPose {
-                line: m.line,
-                rapid: m.motion == Motion::Rapid,
-                arc: m.arc,
-                joints: Joints { xyz: V3::new(m.pos[0], m.pos[1], m.pos[2]), rot },
-                sigma,
-                inverse_time: m.inverse_time,
-                feed: m.feed,
-            })
+            Some((SpindleMode::M19, ..)) => m.orient,
+            _ => None,
+        };
+        Some(NcPose {
+            line: m.line,
+            rapid: m.motion == Motion::Rapid,
+            arc: m.arc,
+            joints: Joints { xyz: V3::new(m.pos[0], m.pos[1], m.pos[2]), rot },
+            sigma,
+            inverse_time: m.inverse_time,
+            feed: m.feed,
         })
-        .collect()
+    }
+}
+
+/// The motion blocks of a program as poses ([`PoseOf`]).
+pub fn poses(prog: &AxisProgram, r: &Reading) -> Vec<Option<NcPose>> {
+    let mut of = PoseOf::default();
+    prog.moves.iter().map(|m| of.pose(m, r)).collect()
+}
+
+/// A program read back from its text, as often as asked: `open` gives a reader from its start
+/// (a spooled program, a file, text in memory), `name` names it in messages.
+#[derive(Clone, Copy)]
+pub struct Program<'a> {
+    /// A reader of the program from its start.
+    pub open: &'a dyn Fn() -> Box<dyn BufRead + 'a>,
+    /// Its name in messages.
+    pub name: &'a str,
+}
+
+impl<'a> Program<'a> {
+    /// The poses of its motion blocks in order, read a block at a time.
+    pub fn poses<'r>(self, r: &'r Reading) -> impl Iterator<Item = Result<Option<NcPose>>> + 'r
+    where
+        'a: 'r,
+    {
+        let mut of = PoseOf::default();
+        AxisBlocks::new(self.name, (self.open)()).map(move |m| m.map(|m| of.pose(&m, r)))
+    }
 }
 
 /// Controller values at fraction `t` of the block from `a` to `b`: every axis linearly, or the
@@ -158,42 +192,54 @@ impl ClPath {
     }
 }
 
-/// The CL path of every segment, ready for many distances: lines straight from the rows, arcs
-/// prepared once and boxed, so that a line costs one pointer (a `ClPath` each took 168 bytes a
-/// segment: 15 MB of the 10× mould stream's read-back check).
-struct Paths<'a> {
-    cl: &'a [Cl],
-    segs: &'a [(usize, usize)],
-    curved: Vec<Option<Box<ClPath>>>,
+/// The CL segments, read through views of the rows (in memory or on disk) and of the segments'
+/// ends (the index of the row each ends at, a feed row; it starts at the row before): a line is
+/// measured from its two rows, an arc prepared once and kept while this thread's search is near
+/// it (a cache cleared when it grows past [`ARC_CACHE`] arcs).
+struct Paths<C, S> {
+    cl: C,
+    segs: S,
+    curved: RefCell<HashMap<usize, Box<ClPath>>>,
 }
 
-impl<'a> Paths<'a> {
-    fn new(cl: &'a [Cl], segs: &'a [(usize, usize)]) -> Paths<'a> {
-        let curved = segs
-            .par_iter()
-            .map(|&(a, b)| cl[b].arc.as_ref().map(|arc| Box::new(ClPath::of(arc, &cl[a].tip, &cl[b].tip))))
-            .collect();
-        Paths { cl, segs, curved }
+/// Arcs a [`Paths`] keeps prepared at most.
+const ARC_CACHE: usize = 1 << 14;
+
+impl<C: Get<Cl>, S: Get<u64>> Paths<C, S> {
+    fn new(cl: C, segs: S) -> Paths<C, S> {
+        Paths { cl, segs, curved: RefCell::new(HashMap::new()) }
     }
 
     fn len(&self) -> usize {
-        self.curved.len()
+        self.segs.len()
+    }
+
+    /// The rows segment `k` runs between.
+    fn ends(&self, k: usize) -> (usize, usize) {
+        let b = self.segs.get(k) as usize;
+        (b - 1, b)
     }
 
     /// Distance of segment `k` from `p` ([`ClPath::distance`]).
     fn distance(&self, k: usize, p: &P3) -> f64 {
-        match &self.curved[k] {
-            Some(c) => c.distance(p),
-            None => point_segment(p, &self.cl[self.segs[k].0].tip, &self.cl[self.segs[k].1].tip),
-        }
+        self.measure(k, p, false)
     }
 
     /// A lower bound of [`Paths::distance`] ([`ClPath::lower_bound`]).
     fn lower_bound(&self, k: usize, p: &P3) -> f64 {
-        match &self.curved[k] {
-            Some(c) => c.lower_bound(p),
-            None => self.distance(k, p),
+        self.measure(k, p, true)
+    }
+
+    fn measure(&self, k: usize, p: &P3, bound: bool) -> f64 {
+        let (a, b) = self.ends(k);
+        let (ra, rb) = (self.cl.get(a), self.cl.get(b));
+        let Some(arc) = rb.arc else { return point_segment(p, &ra.tip, &rb.tip) };
+        let mut curved = self.curved.borrow_mut();
+        if curved.len() >= ARC_CACHE && !curved.contains_key(&k) {
+            curved.clear();
         }
+        let path = curved.entry(k).or_insert_with(|| Box::new(ClPath::of(&arc, &ra.tip, &rb.tip)));
+        if bound { path.lower_bound(p) } else { path.distance(p) }
     }
 }
 
@@ -230,9 +276,9 @@ pub struct Deviation {
     pub axis_deg: f64,
     /// NC line where it occurs.
     pub axis_line: u32,
-    /// Largest axis deviation (degrees) of the samples nearest each CL segment, by the index of
-    /// the row it ends at (0 for rows that start a pass): which rows a program misses.
-    pub row_axis_deg: Vec<f64>,
+    /// The rows (indices, in order) where a sample nearest the CL segment ending there has the
+    /// axis beyond the angle tolerance ([`axis_beyond`]): which rows a program misses.
+    pub axis_rows: Vec<usize>,
     /// Largest error (degrees) of the spindle orientation.
     pub spindle_deg: f64,
     /// Feed blocks compared.
@@ -241,8 +287,14 @@ pub struct Deviation {
     pub samples: usize,
 }
 
-/// Index of the segment of `segs` (pairs of CL indices) nearest `p`, searched near `hint` first.
-fn nearest(p: &P3, paths: &Paths, hint: usize, far: f64) -> (usize, f64) {
+/// True if an axis deviation of `deg` degrees is beyond `--angle-tol` `tol` (degrees), with the
+/// slack of round-off.
+pub fn axis_beyond(deg: f64, tol: f64) -> bool {
+    deg > tol * (1.0 + 1e-6) + 1e-9
+}
+
+/// Index of the segment nearest `p`, searched near `hint` first.
+fn nearest<C: Get<Cl>, S: Get<u64>>(p: &P3, paths: &Paths<C, S>, hint: usize, far: f64) -> (usize, f64) {
     let lo = hint.saturating_sub(2);
     let hi = (hint + 16).min(paths.len());
     let mut best = (hint.min(paths.len().saturating_sub(1)), f64::INFINITY);
@@ -288,36 +340,57 @@ pub const CHUNK: usize = 8192;
 /// `tol` is the tip tolerance: a windowed nearest-segment answer beyond it is searched again in
 /// full (a pass that closes or crosses itself can send the window to the wrong visit), so every
 /// distance above `tol` is exact; and the CL points within `tol` of the tip are where the tool
-/// may be for the axis check. Chunks of blocks and of rows run in parallel; the result is the
-/// same for any thread count.
-pub fn verify(cl: &[Cl], poses: &[Option<NcPose>], r: &Reading, samples_per_block: usize, tol: f64) -> Deviation {
+/// may be for the axis check. Rows whose axis is beyond `angle_tol` (degrees) are listed.
+/// Chunks of blocks and of rows run in parallel; the result is the same for any thread count.
+///
+/// Nothing grows with the program in memory: the program is read a block at a time, a few
+/// chunks of its feed blocks at once; the segments' ends and the program's path go to disk and
+/// are read back through views (the rows may be on disk too), each thread with its own.
+pub fn verify<R: Share<Cl> + ?Sized>(
+    cl: &R,
+    program: Program,
+    r: &Reading,
+    samples_per_block: usize,
+    tol: f64,
+    angle_tol: f64,
+) -> Result<Deviation> {
     let far = tol;
-    let segs: Vec<(usize, usize)> = (1..cl.len()).filter(|&i| !cl[i].rapid).map(|i| (i - 1, i)).collect();
-    let paths = Paths::new(cl, &segs);
-    // Feed blocks as (start, end) poses in program order; a G53 block or an unknown position
-    // breaks the chain.
-    let mut blocks: Vec<(&NcPose, &NcPose)> = Vec::with_capacity(poses.len());
-    let mut prev: Option<&NcPose> = None;
-    for pose in poses {
-        let Some(b) = pose else {
-            prev = None;
-            continue;
-        };
-        if let Some(a) = prev.filter(|_| !b.rapid) {
-            blocks.push((a, b));
+    let rows = cl.view();
+    let mut segs = RecordSpool::<u64>::new();
+    for i in 1..rows.len() {
+        if !rows.get(i).rapid {
+            segs.push(&(i as u64));
         }
-        prev = Some(b);
     }
-    let path = program_path(poses, r, tol);
+    let segs = segs.finish();
+    // Feed blocks as (start, end) poses in program order, a chunk at a time (a G53 block or an
+    // unknown position breaks the chain); the program's path on disk as it is read.
+    let mut path = RecordSpool::<P3>::new();
+    let mut last_known: Option<NcPose> = None;
+    let mut prev: Option<NcPose> = None;
     let mut dev = Deviation::default();
-    if !segs.is_empty() {
+    let batch = rayon::current_num_threads().max(1);
+    let mut chunks: Vec<Vec<(NcPose, NcPose)>> = Vec::new();
+    let mut chunk = Vec::new();
+    let mut done = 0;
+    let check = |chunks: &mut Vec<Vec<(NcPose, NcPose)>>, done: &mut usize, dev: &mut Deviation| {
+        if segs.is_empty() {
+            chunks.clear();
+            return;
+        }
         // The first chunk starts its search at the first segment, as a sequential check would.
-        let parts: Vec<(Deviation, Vec<(usize, f64)>)> = blocks
-            .par_chunks(CHUNK)
+        let parts: Vec<(Deviation, Vec<usize>)> = chunks
+            .par_iter()
             .enumerate()
-            .map(|(c, chunk)| check_blocks(cl, &segs, &paths, chunk, (c == 0).then_some(0), r, samples_per_block, far))
+            .map(|(c, chunk)| {
+                let paths = Paths::new(cl.view(), segs.view());
+                let first = (*done + c == 0).then_some(0);
+                check_blocks(&paths, chunk, first, r, samples_per_block, far, angle_tol)
+            })
             .collect();
-        for (p, _) in &parts {
+        *done += chunks.len();
+        chunks.clear();
+        for (p, beyond) in parts {
             if p.tip > dev.tip {
                 (dev.tip, dev.tip_line) = (p.tip, p.tip_line);
             }
@@ -327,28 +400,50 @@ pub fn verify(cl: &[Cl], poses: &[Option<NcPose>], r: &Reading, samples_per_bloc
             dev.spindle_deg = dev.spindle_deg.max(p.spindle_deg);
             dev.blocks += p.blocks;
             dev.samples += p.samples;
+            dev.axis_rows.extend(beyond);
         }
-        dev.row_axis_deg = vec![0.0; cl.len()];
-        for &(i, d) in parts.iter().flat_map(|(_, rows)| rows) {
-            dev.row_axis_deg[i] = dev.row_axis_deg[i].max(d);
+    };
+    for pose in program.poses(r) {
+        let Some(b) = pose? else {
+            prev = None;
+            continue;
+        };
+        push_path(&mut path, last_known.as_ref(), &b, r, tol);
+        last_known = Some(b);
+        if let Some(a) = prev.filter(|_| !b.rapid) {
+            chunk.push((a, b));
+            if chunk.len() == CHUNK {
+                chunks.push(std::mem::take(&mut chunk));
+                if chunks.len() == batch {
+                    check(&mut chunks, &mut done, &mut dev);
+                }
+            }
         }
+        prev = Some(b);
     }
+    if !chunk.is_empty() {
+        chunks.push(chunk);
+    }
+    check(&mut chunks, &mut done, &mut dev);
+    dev.axis_rows.sort_unstable();
+    dev.axis_rows.dedup();
     // Coverage: every CL row lies on the program's path.
+    let path = path.finish();
     if path.is_empty() {
         dev.coverage = f64::INFINITY;
-        return dev;
+        return Ok(dev);
     }
-    let parts: Vec<(f64, usize)> = cl
-        .par_chunks(CHUNK)
-        .enumerate()
-        .map(|(c, rows)| {
+    let parts: Vec<(f64, usize)> = (0..rows.len().div_ceil(CHUNK))
+        .into_par_iter()
+        .map(|c| {
+            let (rows, path) = (cl.view(), path.view());
             let mut worst = (0.0, c * CHUNK);
             let mut j = (c == 0).then_some(0);
-            for (i, row) in rows.iter().enumerate() {
-                let (k, d) = nearest_on_path(&row.tip, &path, j, far);
+            for i in c * CHUNK..((c + 1) * CHUNK).min(rows.len()) {
+                let (k, d) = nearest_on_path(&rows.get(i).tip, &path, j, far);
                 j = Some(k);
                 if d > worst.0 {
-                    worst = (d, c * CHUNK + i);
+                    worst = (d, i);
                 }
             }
             worst
@@ -359,43 +454,41 @@ pub fn verify(cl: &[Cl], poses: &[Option<NcPose>], r: &Reading, samples_per_bloc
             (dev.coverage, dev.coverage_row) = (d, i);
         }
     }
-    dev
+    Ok(dev)
 }
 
-/// The program's path in the workpiece frame: every block's end, and points along each arc close
-/// enough that the chords stay within a twentieth of `tol` of it.
-fn program_path(poses: &[Option<NcPose>], r: &Reading, tol: f64) -> Vec<P3> {
-    let known: Vec<&NcPose> = poses.iter().filter_map(|p| p.as_ref()).collect();
-    let parts: Vec<Vec<P3>> = (0..known.len())
-        .into_par_iter()
-        .map(|i| {
-            let b = known[i];
-            let mut out = Vec::new();
-            if let (Some(arc), Some(a)) = (&b.arc, i.checked_sub(1).map(|k| known[k])) {
-                let (plane_arc, _, _) = arc.in_plane(&P3::from(a.joints.xyz), &P3::from(b.joints.xyz));
-                let sag = (tol / 20.0).min(plane_arc.r);
-                let step = 2.0 * (1.0 - sag / plane_arc.r).acos();
-                let n = ((plane_arc.sweep.abs() / step).ceil() as usize).clamp(1, 1_000_000);
-                for k in 1..n {
-                    out.push(r.at(&joints_at(a, b, k as f64 / n as f64)).0);
-                }
-            }
-            out.push(r.at(&b.joints).0);
-            out
-        })
-        .collect();
-    parts.concat()
+/// Appends to the program's path in the workpiece frame the block ending at `b` (after the known
+/// block `a`): points along an arc close enough that the chords stay within a twentieth of `tol`
+/// of it, and the block's end.
+fn push_path(path: &mut RecordSpool<P3>, a: Option<&NcPose>, b: &NcPose, r: &Reading, tol: f64) {
+    if let (Some(arc), Some(a)) = (&b.arc, a) {
+        let (plane_arc, _, _) = arc.in_plane(&P3::from(a.joints.xyz), &P3::from(b.joints.xyz));
+        let sag = (tol / 20.0).min(plane_arc.r);
+        let step = 2.0 * (1.0 - sag / plane_arc.r).acos();
+        let n = ((plane_arc.sweep.abs() / step).ceil() as usize).clamp(1, 1_000_000);
+        for k in 1..n {
+            path.push(&r.at(&joints_at(a, b, k as f64 / n as f64)).0);
+        }
+    }
+    path.push(&r.at(&b.joints).0);
 }
 
 /// Index of the program path's segment (or last point) nearest `p` and its distance: searched
 /// near `hint` first, everywhere when there is no hint or nothing within `far` near it.
-fn nearest_on_path(p: &P3, path: &[P3], hint: Option<usize>, far: f64) -> (usize, f64) {
+fn nearest_on_path<G: Get<P3>>(p: &P3, path: &G, hint: Option<usize>, far: f64) -> (usize, f64) {
     let scan = |lo: usize, hi: usize, best: &mut (usize, f64)| {
+        let mut here = (lo < hi).then(|| path.get(lo));
         for k in lo..hi {
-            let d = if k + 1 < path.len() { point_segment(p, &path[k], &path[k + 1]) } else { (p - path[k]).norm() };
+            let a = here.expect("a point before the end");
+            let next = (k + 1 < path.len()).then(|| path.get(k + 1));
+            let d = match next {
+                Some(b) => point_segment(p, &a, &b),
+                None => (p - a).norm(),
+            };
             if d < best.1 {
                 *best = (k, d);
             }
+            here = next;
         }
     };
     let mut best = (hint.unwrap_or(0), f64::INFINITY);
@@ -425,24 +518,23 @@ const AXIS_WALK: usize = 64;
 /// nearest may be any of them (it once took the one leaving a 20° turn and measured the turn's
 /// first block against the turn's last 10°): the samples follow the turn in order from `from`,
 /// a bounded walk however many rows the turn has.
-#[allow(clippy::too_many_arguments)]
-fn axis_deviation(
+fn axis_deviation<C: Get<Cl>, S: Get<u64>>(
     tip: &P3,
     axis: &V3,
-    cl: &[Cl],
-    segs: &[(usize, usize)],
-    paths: &Paths,
+    paths: &Paths<C, S>,
     (seg, d): (usize, f64),
     from: Option<usize>,
     tol: f64,
 ) -> (f64, usize) {
+    let cl = &paths.cl;
     let at = |k: usize, dk: f64| {
-        let (a, b) = segs[k];
-        let len = (cl[b].tip - cl[a].tip).norm();
-        let u = param(tip, &cl[a].tip, &cl[b].tip);
+        let (a, b) = paths.ends(k);
+        let (ra, rb) = (cl.get(a), cl.get(b));
+        let len = (rb.tip - ra.tip).norm();
+        let u = param(tip, &ra.tip, &rb.tip);
         let half = if len > 0.0 { (tol * tol - dk * dk).max(0.0).sqrt() / len } else { 1.0 };
         let (lo, hi) = ((u - half).max(0.0), (u + half).min(1.0));
-        vector_arc(axis, &slerp(&cl[a].axis, &cl[b].axis, lo), &slerp(&cl[a].axis, &cl[b].axis, hi))
+        vector_arc(axis, &slerp(&ra.axis, &rb.axis, lo), &slerp(&ra.axis, &rb.axis, hi))
     };
     let near = |k: usize| Some(paths.distance(k, tip)).filter(|&dk| dk <= tol);
     let mut best = (at(seg, d), seg);
@@ -452,8 +544,8 @@ fn axis_deviation(
             best = (a, k);
         }
     };
-    let back = |k: usize| k.checked_sub(1).filter(|&p| segs[p].1 == segs[k].0);
-    let ahead = |k: usize| Some(k + 1).filter(|&n| n < segs.len() && segs[n].0 == segs[k].1);
+    let back = |k: usize| k.checked_sub(1).filter(|&p| paths.ends(p).1 == paths.ends(k).0);
+    let ahead = |k: usize| Some(k + 1).filter(|&n| n < paths.len() && paths.ends(n).0 == paths.ends(k).1);
     for k in [back(seg), ahead(seg)].into_iter().flatten() {
         if let Some(dk) = near(k) {
             take(k, dk);
@@ -478,23 +570,22 @@ fn axis_deviation(
 }
 
 /// The block part of [`verify`] for one chunk of consecutive feed blocks, the nearest-segment
-/// search starting at `hint` (none: a full search); with the largest axis deviation near each row
-/// sampled, as (row, degrees).
-#[allow(clippy::too_many_arguments)]
-fn check_blocks(
-    cl: &[Cl],
-    segs: &[(usize, usize)],
-    paths: &Paths,
-    blocks: &[(&NcPose, &NcPose)],
+/// search starting at `hint` (none: a full search); with the rows near which a sample has the
+/// axis beyond `angle_tol` (degrees), in order of the samples.
+fn check_blocks<C: Get<Cl>, S: Get<u64>>(
+    paths: &Paths<C, S>,
+    blocks: &[(NcPose, NcPose)],
     mut hint: Option<usize>,
     r: &Reading,
     samples_per_block: usize,
     far: f64,
-) -> (Deviation, Vec<(usize, f64)>) {
+    angle_tol: f64,
+) -> (Deviation, Vec<usize>) {
+    let cl = &paths.cl;
     let mut dev = Deviation::default();
-    let mut by_row: Vec<(usize, f64)> = Vec::new();
+    let mut beyond: Vec<usize> = Vec::new();
     let mut axis_hint = None;
-    for &(a, b) in blocks {
+    for (a, b) in blocks {
         dev.blocks += 1;
         let samples = samples_of(a, b, samples_per_block);
         for k in 0..=samples {
@@ -512,26 +603,26 @@ fn check_blocks(
                 dev.tip = d;
                 dev.tip_line = b.line;
             }
-            let (da, matched) = axis_deviation(&tip, &axis, cl, segs, paths, (seg, d), axis_hint, far);
+            let (da, matched) = axis_deviation(&tip, &axis, paths, (seg, d), axis_hint, far);
             axis_hint = Some(matched);
             let da = da.to_degrees();
-            let (i0, i1) = segs[seg];
-            let u = param(&tip, &cl[i0].tip, &cl[i1].tip);
+            let (i0, i1) = paths.ends(seg);
+            let (r0, r1) = (cl.get(i0), cl.get(i1));
+            let u = param(&tip, &r0.tip, &r1.tip);
             if da > dev.axis_deg {
                 dev.axis_deg = da;
                 dev.axis_line = b.line;
             }
             // Consecutive samples near one row merged.
-            match by_row.last_mut() {
-                Some((row, d)) if *row == i1 => *d = d.max(da),
-                _ => by_row.push((i1, da)),
+            if axis_beyond(da, angle_tol) && beyond.last() != Some(&i1) {
+                beyond.push(i1);
             }
             let sigma = match (r.spindle, a.sigma, b.sigma) {
                 (Some((SpindleMode::Axis, ..)), Some(x), Some(y)) => Some(x + (y - x) * t),
                 (Some((SpindleMode::M19, ..)), _, y) => y,
                 _ => None,
             };
-            if let (Some(sig), Some(s0), Some(s1)) = (sigma, cl[i0].s, cl[i1].s) {
+            if let (Some(sig), Some(s0), Some(s1)) = (sigma, r0.s, r1.s) {
                 let want_s = s0 + principal_deg(s1 - s0) * u;
                 if let Some(have) = r.s_of(&q.rot, sig) {
                     dev.spindle_deg = dev.spindle_deg.max(principal_deg(have - want_s).abs());
@@ -539,7 +630,7 @@ fn check_blocks(
             }
         }
     }
-    (dev, by_row)
+    (dev, beyond)
 }
 
 /// The program as a toolpath table: tool tip, axis, spindle orientation and feed (mm/min) per

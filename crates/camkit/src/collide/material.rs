@@ -64,6 +64,40 @@ struct Cut {
     z1: f64,
 }
 
+/// Cuts per block of a [`History`].
+const HISTORY_BLOCK: usize = 4096;
+
+/// Every cut, in order, kept in blocks of [`HISTORY_BLOCK`]: the history grows a block at a time
+/// and is never copied into a larger one (a doubling vector holds both copies while it grows: a
+/// third of a long program's history, transiently, at every doubling).
+#[derive(Clone, Debug, Default, PartialEq)]
+struct History {
+    blocks: Vec<Vec<Cut>>,
+    len: usize,
+}
+
+impl History {
+    fn len(&self) -> usize {
+        self.len
+    }
+
+    fn push(&mut self, cut: Cut) {
+        if self.blocks.last().is_none_or(|b| b.len() == HISTORY_BLOCK) {
+            self.blocks.push(Vec::with_capacity(HISTORY_BLOCK));
+        }
+        self.blocks.last_mut().expect("a block with room").push(cut);
+        self.len += 1;
+    }
+}
+
+impl std::ops::Index<usize> for History {
+    type Output = Cut;
+
+    fn index(&self, k: usize) -> &Cut {
+        &self.blocks[k / HISTORY_BLOCK][k % HISTORY_BLOCK]
+    }
+}
+
 /// The remaining stock.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Material {
@@ -75,7 +109,7 @@ pub struct Material {
     top: Vec<f64>,
     bottom: f64,
     /// Every cut, in order.
-    cuts: Vec<Cut>,
+    cuts: History,
     /// The cuts whose reach meets each bucket (squares of `bucket` mm from `origin`).
     buckets: std::collections::HashMap<(i64, i64), Vec<u32>>,
     bucket: f64,
@@ -118,7 +152,7 @@ impl Material {
             ny,
             top,
             bottom: stock.bottom(),
-            cuts: Vec::new(),
+            cuts: History::default(),
             buckets: Default::default(),
             bucket,
         })

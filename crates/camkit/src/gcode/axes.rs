@@ -172,23 +172,85 @@ fn words(name: &str, line_no: u32, line: &str) -> Result<Vec<Word>> {
 
 /// Reads a multi-axis program. `name` is used in error messages.
 pub fn read_axes(name: &str, text: &str) -> Result<AxisProgram> {
-    let mut prog = AxisProgram::default();
-    let mut units = Units::Mm;
-    let (mut relative, mut inverse_time, mut tcp) = (false, false, false);
-    let mut motion: Option<Motion> = None;
-    let mut plane = Plane::Xy;
-    let mut absolute_centres = false;
-    let mut feed: Option<f64> = None;
-    let mut pos = [0.0; 6];
-    let mut known = [false; 6];
-    let mut orient: Option<f64> = None;
-    for (idx, raw) in text.lines().enumerate() {
-        let line_no = idx as u32 + 1;
-        prog.lines += 1;
+    let mut blocks = AxisBlocks::new(name, text.as_bytes());
+    let moves = blocks.by_ref().collect::<Result<Vec<AxisMove>>>()?;
+    Ok(AxisProgram { moves, orients: blocks.orients, lines: blocks.lines })
+}
+
+/// The modes and positions in effect between blocks.
+#[derive(Clone, Copy, Debug)]
+struct State {
+    units: Units,
+    relative: bool,
+    inverse_time: bool,
+    tcp: bool,
+    motion: Option<Motion>,
+    plane: Plane,
+    absolute_centres: bool,
+    feed: Option<f64>,
+    pos: [f64; 6],
+    known: [bool; 6],
+    orient: Option<f64>,
+}
+
+/// The motion blocks of a multi-axis program read from a stream one at a time, as
+/// [`read_axes`] reads them (the same blocks and the same errors at the same lines), holding one
+/// line: a program of any length is read back in constant memory. Text that is not UTF-8 is an
+/// error naming its line.
+#[derive(Debug)]
+pub struct AxisBlocks<'a, R> {
+    name: &'a str,
+    src: R,
+    state: State,
+    buf: Vec<u8>,
+    failed: bool,
+    /// `M19` blocks read so far.
+    pub orients: usize,
+    /// Lines read so far.
+    pub lines: usize,
+}
+
+impl<'a, R: std::io::BufRead> AxisBlocks<'a, R> {
+    /// A reader of `src`; `name` is used in error messages.
+    pub fn new(name: &'a str, src: R) -> AxisBlocks<'a, R> {
+        AxisBlocks {
+            name,
+            src,
+            state: State {
+                units: Units::Mm,
+                relative: false,
+                inverse_time: false,
+                tcp: false,
+                motion: None,
+                plane: Plane::Xy,
+                absolute_centres: false,
+                feed: None,
+                pos: [0.0; 6],
+                known: [false; 6],
+                orient: None,
+            },
+            buf: Vec::new(),
+            failed: false,
+            orients: 0,
+            lines: 0,
+        }
+    }
+
+    /// The block of one line, if it moves.
+    fn line(&mut self, line_no: u32, raw: &str) -> Result<Option<AxisMove>> {
+        let name = self.name;
+        let mut st = self.state;
+        let block = self.step(&mut st, name, line_no, raw);
+        self.state = st;
+        block
+    }
+
+    fn step(&mut self, st: &mut State, name: &str, line_no: u32, raw: &str) -> Result<Option<AxisMove>> {
+        self.lines += 1;
         let line = raw.trim_end_matches('\r');
         let trimmed = line.trim_start();
         if trimmed.is_empty() || trimmed.starts_with('%') || trimmed.starts_with('/') {
-            continue;
+            return Ok(None);
         }
         let ws = words(name, line_no, line)?;
         let word_text = |w: &Word| line[w.start..w.end].to_string();
@@ -202,7 +264,7 @@ pub fn read_axes(name: &str, text: &str) -> Result<AxisProgram> {
         }
         if ws.first().is_some_and(|w| w.letter == b'O') {
             if ws.len() == 1 {
-                continue; // Fanuc program number.
+                return Ok(None); // Fanuc program number.
             }
             return Err(err(
                 name,
@@ -228,21 +290,21 @@ pub fn read_axes(name: &str, text: &str) -> Result<AxisProgram> {
                             _ => Motion::Ccw,
                         });
                     }
-                    170 => plane = Plane::Xy,
-                    180 => plane = Plane::Xz,
-                    190 => plane = Plane::Yz,
-                    901 => absolute_centres = true,
-                    911 => absolute_centres = false,
-                    200 => units = Units::Inch,
-                    210 => units = Units::Mm,
-                    900 => relative = false,
-                    910 => relative = true,
-                    930 => inverse_time = true,
-                    940 => inverse_time = false,
+                    170 => st.plane = Plane::Xy,
+                    180 => st.plane = Plane::Xz,
+                    190 => st.plane = Plane::Yz,
+                    901 => st.absolute_centres = true,
+                    911 => st.absolute_centres = false,
+                    200 => st.units = Units::Inch,
+                    210 => st.units = Units::Mm,
+                    900 => st.relative = false,
+                    910 => st.relative = true,
+                    930 => st.inverse_time = true,
+                    940 => st.inverse_time = false,
                     530 => g53 = true,
-                    434 => tcp = true,
-                    490 => tcp = false,
-                    800 => motion = None,
+                    434 => st.tcp = true,
+                    490 => st.tcp = false,
+                    800 => st.motion = None,
                     // Cutter compensation off, tool length offset, exact stop and path modes, work
                     // offsets: nothing that moves or scales a position.
                     400 | 430 | 610 | 611 | 640 | 150 | 690 | 540..=590 | 591..=593 => {}
@@ -265,52 +327,52 @@ pub fn read_axes(name: &str, text: &str) -> Result<AxisProgram> {
         }
         if m19 {
             let r = ws.iter().find(|w| w.letter == b'R').map_or(0.0, |w| w.value);
-            orient = Some(r);
-            prog.orients += 1;
+            st.orient = Some(r);
+            self.orients += 1;
         }
         if let Some(w) = ws.iter().find(|w| w.letter == b'F') {
             if w.value <= 0.0 {
                 return Err(err(name, line_no, w.start, &word_text(w), "feed must be positive"));
             }
-            feed = Some(if inverse_time { w.value } else { w.value * units.mm() });
+            st.feed = Some(if st.inverse_time { w.value } else { w.value * st.units.mm() });
         }
         if let Some(m) = block_motion {
-            motion = Some(m);
+            st.motion = Some(m);
         }
         let named: [bool; 6] = std::array::from_fn(|k| ws.iter().any(|w| w.letter == AXIS_LETTERS[k]));
         // A full circle names no axis: its centre words make it a move.
         let circle =
-            motion.is_some_and(Motion::is_arc) && ws.iter().any(|w| matches!(w.letter, b'I' | b'J' | b'K' | b'R'));
+            st.motion.is_some_and(Motion::is_arc) && ws.iter().any(|w| matches!(w.letter, b'I' | b'J' | b'K' | b'R'));
         if !named.iter().any(|n| *n) && !circle {
             if g53 {
                 return Err(err(name, line_no, 0, line, "G53 without coordinates"));
             }
-            if inverse_time && block_motion.is_none() {
+            if st.inverse_time && block_motion.is_none() {
                 // A G93 F word that is not on a motion block does not carry to the next block.
-                feed = None;
+                st.feed = None;
             }
-            continue;
+            return Ok(None);
         }
-        let Some(m) = motion else {
+        let Some(m) = st.motion else {
             return Err(err(name, line_no, 0, line, "coordinates without a motion mode (G0 or G1)"));
         };
-        if g53 && relative {
+        if g53 && st.relative {
             return Err(err(name, line_no, 0, line, "G53 in incremental mode (G91)"));
         }
-        if m == Motion::Line && feed.is_none() {
-            let what = if inverse_time {
+        if m == Motion::Line && st.feed.is_none() {
+            let what = if st.inverse_time {
                 "a G1 block in inverse-time mode (G93) needs its own F word"
             } else {
                 "G1 without a feed rate (F)"
             };
             return Err(err(name, line_no, 0, line, what));
         }
-        let mut block_pos = pos;
+        let mut block_pos = st.pos;
         for w in &ws {
             if let Some(k) = AXIS_LETTERS.iter().position(|&l| l == w.letter) {
-                let v = if k < 3 { w.value * units.mm() } else { w.value };
-                block_pos[k] = if relative && !g53 {
-                    if !known[k] {
+                let v = if k < 3 { w.value * st.units.mm() } else { w.value };
+                block_pos[k] = if st.relative && !g53 {
+                    if !st.known[k] {
                         return Err(err(
                             name,
                             line_no,
@@ -319,7 +381,7 @@ pub fn read_axes(name: &str, text: &str) -> Result<AxisProgram> {
                             "incremental move from an unknown position",
                         ));
                     }
-                    pos[k] + v
+                    st.pos[k] + v
                 } else {
                     v
                 };
@@ -327,18 +389,30 @@ pub fn read_axes(name: &str, text: &str) -> Result<AxisProgram> {
         }
         let n = ws.iter().find(|w| w.letter == b'N').map(|w| w.value as u64);
         let arc = if m.is_arc() {
-            Some(arc_of(name, line_no, line, &ws, m, plane, absolute_centres, units, &pos, &known, &block_pos)?)
+            Some(arc_of(
+                name,
+                line_no,
+                line,
+                &ws,
+                m,
+                st.plane,
+                st.absolute_centres,
+                st.units,
+                &st.pos,
+                &st.known,
+                &block_pos,
+            )?)
         } else {
             if let Some(w) = ws.iter().find(|w| matches!(w.letter, b'I' | b'J' | b'K') || (w.letter == b'R' && !m19)) {
                 return Err(err(name, line_no, w.start, &word_text(w), "I, J, K and R belong to arcs (G2, G3)"));
             }
             None
         };
-        let mut block_known = known;
+        let mut block_known = st.known;
         for k in 0..6 {
             block_known[k] |= named[k];
         }
-        prog.moves.push(AxisMove {
+        let block = AxisMove {
             line: line_no,
             motion: m,
             arc,
@@ -346,28 +420,62 @@ pub fn read_axes(name: &str, text: &str) -> Result<AxisProgram> {
             known: block_known,
             named,
             machine_coords: g53,
-            inverse_time,
-            feed,
-            tcp,
-            orient,
+            inverse_time: st.inverse_time,
+            feed: st.feed,
+            tcp: st.tcp,
+            orient: st.orient,
             n,
-        });
+        };
         if g53 {
             // After a move in machine coordinates the work position of the named axes is not known.
-            for k in 0..6 {
-                if named[k] {
-                    known[k] = false;
+            for (known, named) in st.known.iter_mut().zip(named) {
+                if named {
+                    *known = false;
                 }
             }
         } else {
-            pos = block_pos;
-            known = block_known;
+            st.pos = block_pos;
+            st.known = block_known;
         }
-        if inverse_time {
-            feed = None;
+        if st.inverse_time {
+            st.feed = None;
         }
+        Ok(Some(block))
     }
-    Ok(prog)
+}
+
+impl<R: std::io::BufRead> Iterator for AxisBlocks<'_, R> {
+    type Item = Result<AxisMove>;
+
+    fn next(&mut self) -> Option<Result<AxisMove>> {
+        while !self.failed {
+            self.buf.clear();
+            let read = self.src.read_until(b'\n', &mut self.buf);
+            let line_no = self.lines as u32 + 1;
+            let at = || Location::file(self.name).line(u64::from(line_no));
+            let text = match read {
+                Ok(0) => return None,
+                Ok(_) => match std::str::from_utf8(&self.buf) {
+                    Ok(t) => Ok(t.strip_suffix('\n').unwrap_or(t).to_string()),
+                    Err(_) => Err(Error::input("text is not valid UTF-8").at(at())),
+                },
+                Err(e) => Err(Error::io(e, self.name)),
+            };
+            let block = match text {
+                Ok(text) => self.line(line_no, &text),
+                Err(e) => Err(e),
+            };
+            match block {
+                Ok(None) => {}
+                Ok(Some(b)) => return Some(Ok(b)),
+                Err(e) => {
+                    self.failed = true;
+                    return Some(Err(e));
+                }
+            }
+        }
+        None
+    }
 }
 
 /// The circle of a G2/G3 block: from the centre words I/J/K (offsets from the start, or absolute
@@ -517,6 +625,28 @@ mod tests {
         assert_eq!((arc.plane, arc.centre), (Plane::Xz, P2::new(-3.0, 0.0)));
         let (_, _, arc) = at(4);
         assert_eq!((arc.plane, arc.centre, arc.ccw), (Plane::Yz, P2::new(0.0, 5.0), false));
+    }
+
+    /// Read from a stream a line at a time, a program gives the blocks, counts and errors of the
+    /// whole text read at once, CRLF and a last line without its end included; text that stops
+    /// being UTF-8 is refused naming its line.
+    #[test]
+    fn streamed_blocks_are_the_whole_reading() {
+        let text = "%\r\nG21 G90\r\nG0 X1 Y2 Z3 A4 C5\nM19 R45.5\nG93 G1 X2 A10 C20 F100\n\nG94 G1 X4 F500\n\
+                    G0 X10 Y0 Z0\nG3 X0 Y10 I-10 J0 F100\nG53 G0 Z0\nG1 X3 F50";
+        let whole = read_axes("t.nc", text).unwrap();
+        let mut blocks = AxisBlocks::new("t.nc", std::io::BufReader::with_capacity(7, text.as_bytes()));
+        let moves: Vec<AxisMove> = blocks.by_ref().map(|b| b.unwrap()).collect();
+        assert_eq!(moves, whole.moves);
+        assert_eq!((blocks.orients, blocks.lines), (whole.orients, whole.lines));
+        assert_eq!((whole.moves.len(), whole.lines), (7, 11));
+        let bad = "G0 X0\nG1 X1 F10\nG1 X1 X2\nG1 X3\n";
+        let streamed: Vec<Result<AxisMove>> = AxisBlocks::new("t.nc", bad.as_bytes()).collect();
+        assert_eq!(streamed.len(), 3, "reading stops at the error");
+        let e = streamed[2].as_ref().unwrap_err();
+        assert_eq!(e.to_string(), read_axes("t.nc", bad).unwrap_err().to_string());
+        let e = AxisBlocks::new("t.nc", &b"G0 X0\nG0 X\xff\n"[..]).find_map(|b| b.err()).unwrap();
+        assert!(e.to_string().starts_with("t.nc:2") && e.to_string().contains("UTF-8"), "{e}");
     }
 
     #[test]

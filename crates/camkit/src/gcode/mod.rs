@@ -8,7 +8,7 @@ mod read;
 mod table;
 mod write;
 
-pub use axes::{AXIS_LETTERS, AxisArc, AxisMove, AxisProgram, read_axes};
+pub use axes::{AXIS_LETTERS, AxisArc, AxisBlocks, AxisMove, AxisProgram, read_axes};
 pub use read::{Blocks, Decimals, StreamBlocks, read};
 pub use table::{program_to_table, table_to_program};
 pub use write::{OutMove, Writer};
