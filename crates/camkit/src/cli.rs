@@ -16,8 +16,9 @@ pub fn program() -> &'static str {
 
 /// Runs a filter's body: errors become one line on stderr (`name: file:line:col (field): what`)
 /// and the exit status of their kind; a closed output pipe ends quietly with status 0; a panic
-/// (a bug) prints one line, not a backtrace; an interrupt (SIGINT, SIGTERM, SIGHUP) removes the
-/// output file being written and exits with 130.
+/// (a bug) prints one line, not a backtrace, and a temporary file's failing disk
+/// ([`crate::io::DiskFailure`]) is a runtime failure (exit 1); an interrupt (SIGINT, SIGTERM,
+/// SIGHUP) removes the output file being written and exits with 130.
 pub fn run(name: &'static str, body: impl FnOnce() -> Result<()>) -> ExitCode {
     let _ = PROGRAM.set(name);
     let _ = ctrlc::set_handler(|| {
@@ -25,6 +26,9 @@ pub fn run(name: &'static str, body: impl FnOnce() -> Result<()>) -> ExitCode {
         std::process::exit(130);
     });
     std::panic::set_hook(Box::new(|info| {
+        if info.payload().is::<crate::io::DiskFailure>() {
+            return; // said by the caller below
+        }
         let place = info.location().map(|l| format!(" at {}:{}", l.file(), l.line())).unwrap_or_default();
         let what = info
             .payload()
@@ -34,7 +38,14 @@ pub fn run(name: &'static str, body: impl FnOnce() -> Result<()>) -> ExitCode {
             .unwrap_or_else(|| "panic".into());
         eprintln!("{}: internal error (a bug, please report it): {what}{place}", program());
     }));
-    match body() {
+    // The body's values are dropped while unwinding (an output being written is removed).
+    let outcome = std::panic::catch_unwind(std::panic::AssertUnwindSafe(body)).unwrap_or_else(|p| {
+        match p.downcast::<crate::io::DiskFailure>() {
+            Ok(f) => Err(crate::error::Error::runtime(f.0)),
+            Err(p) => std::panic::resume_unwind(p),
+        }
+    });
+    match outcome {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
             if e.kind != crate::error::ErrorKind::BrokenPipe {
@@ -223,6 +234,14 @@ impl Drop for Progress {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_failing_disk_is_a_runtime_failure_and_a_bug_still_panics() {
+        let failed = || -> Result<()> { std::panic::panic_any(crate::io::DiskFailure("disk full".into())) };
+        assert_eq!(run("t", failed), ExitCode::from(1));
+        let bug = std::panic::catch_unwind(|| run("t", || -> Result<()> { panic!("a bug") }));
+        assert!(bug.is_err());
+    }
 
     #[test]
     fn numeric_options_are_finite_and_in_range() {

@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 
 pub mod spool;
-pub use spool::{Get, Record, RecordSpool, Records, Share, Spool, Spooled, View};
+pub use spool::{DiskFailure, Get, Record, RecordSpool, Records, Share, Spool, Spooled, View};
 
 /// The temporary files outputs are being written to: an interrupt removes them (see
 /// [`remove_pending`]), so that a run stopped while writing or committing leaves nothing behind.

@@ -12,8 +12,10 @@
 //!   that it runs on slices in memory and on records on disk alike.
 //!
 //! Records cannot meet bad input, only a failing disk (a full one, or one gone): their reads and
-//! writes panic on an I/O error, naming it, so that the geometry that reads them stays free of
-//! error paths no input can reach. A [`Spool`] of bytes returns its errors, as any writer.
+//! writes unwind on an I/O error with a [`DiskFailure`], naming it, so that the geometry that
+//! reads them stays free of error paths no input can reach; [`crate::cli::run`] turns it into a
+//! runtime failure (one line, exit 1, the output not written). A [`Spool`] of bytes returns its
+//! errors, as any writer.
 
 use std::cell::RefCell;
 use std::fs::File;
@@ -249,9 +251,13 @@ struct Page {
     dirty: bool,
 }
 
-/// Panics for an I/O error of a temporary file (see the module's documentation).
+/// What a records' temporary file failing unwinds with (see the module's documentation).
+#[derive(Debug)]
+pub struct DiskFailure(pub String);
+
+/// Unwinds for an I/O error of a temporary file (see the module's documentation).
 fn failed(e: std::io::Error) -> ! {
-    panic!("a temporary file cannot be written or read back: {e}")
+    std::panic::panic_any(DiskFailure(format!("a temporary file cannot be written or read back: {e}")))
 }
 
 /// Records of one type by index: appended, read and overwritten through a one-page cache
