@@ -434,14 +434,7 @@ fn clipped_plane(c: &Cutter, q: [f64; 2], a: &P3, n: &V3, b: &Aabb) -> f64 {
             best = best.max(g(x, y));
         }
     }
-    let corners = [(b.min.x, b.min.y), (b.max.x, b.min.y), (b.max.x, b.max.y), (b.min.x, b.max.y)];
-    for k in 0..4 {
-        let (p0, p1) = (corners[k], corners[(k + 1) % 4]);
-        if let Some((t0, t1)) = in_disc(q, big_r, p0, p1) {
-            let (dx, dy) = (p1.0 - p0.0, p1.1 - p0.1);
-            best = best.max(golden_max(|t| g(p0.0 + t * dx, p0.1 + t * dy), t0, t1));
-        }
-    }
+    best = best.max(edges_max(b, q, big_r, &g));
     best
 }
 
@@ -513,14 +506,7 @@ fn capped_plane(c: &Cutter, q: [f64; 2], a: &P3, n: &V3, b: &Aabb) -> f64 {
             best = best.max(g(x, y));
         }
     }
-    let corners = [(b.min.x, b.min.y), (b.max.x, b.min.y), (b.max.x, b.max.y), (b.min.x, b.max.y)];
-    for k in 0..4 {
-        let (p0, p1) = (corners[k], corners[(k + 1) % 4]);
-        if let Some((t0, t1)) = in_disc(q, big_r, p0, p1) {
-            let (dx, dy) = (p1.0 - p0.0, p1.1 - p0.1);
-            best = best.max(golden_max(|t| g(p0.0 + t * dx, p0.1 + t * dy), t0, t1));
-        }
-    }
+    best = best.max(edges_max(b, q, big_r, &g));
     best
 }
 
@@ -543,6 +529,21 @@ fn in_disc(q: [f64; 2], r: f64, p0: (f64, f64), p1: (f64, f64)) -> Option<(f64, 
         (((-bb - s) / aa).max(0.0), ((-bb + s) / aa).min(1.0))
     };
     (t0 <= t1).then_some((t0, t1))
+}
+
+/// The largest of `g` along the box's four edges where they lie in the disc of radius `big_r`
+/// round `q` (golden-section search on each piece; −∞ where none does).
+fn edges_max(b: &Aabb, q: [f64; 2], big_r: f64, g: &impl Fn(f64, f64) -> f64) -> f64 {
+    let corners = [(b.min.x, b.min.y), (b.max.x, b.min.y), (b.max.x, b.max.y), (b.min.x, b.max.y)];
+    let mut best = f64::NEG_INFINITY;
+    for k in 0..4 {
+        let (p0, p1) = (corners[k], corners[(k + 1) % 4]);
+        if let Some((t0, t1)) = in_disc(q, big_r, p0, p1) {
+            let (dx, dy) = (p1.0 - p0.0, p1.1 - p0.1);
+            best = best.max(golden_max(|t| g(p0.0 + t * dx, p0.1 + t * dy), t0, t1));
+        }
+    }
+    best
 }
 
 /// True when the piece's control points (whose hull holds it) lie beyond the shadow's tangent
