@@ -116,7 +116,8 @@ fn wedge(p: &P2, r: f64, c: P2, a0: f64, w: f64, d0: V2, d1: V2) -> AngleSet {
 }
 
 /// The cutting moves of one layer in machining order, with a grid to find the pieces near a
-/// point.
+/// point (each piece listed in the cells it runs through, not all those of its box: a wide
+/// arc's box covers the pocket).
 pub struct Cut {
     /// Tool radius (mm).
     pub radius: f64,
@@ -124,8 +125,8 @@ pub struct Cut {
     pub pieces: Vec<Seg>,
     /// Bounding box of each piece.
     boxes: Vec<(P2, P2)>,
-    /// Grid cell of the low corner of each piece's box.
-    first: Vec<(i64, i64)>,
+    /// How each piece is listed in the grid.
+    listed: Vec<Listed>,
     /// Constants of each piece for its angle sets.
     shapes: Vec<Shape>,
     cell: f64,
@@ -139,34 +140,27 @@ impl Cut {
         let cell = radius;
         let boxes: Vec<(P2, P2)> = pieces.iter().map(Seg::bounds).collect();
         let mut grid: HashMap<(i64, i64), Vec<usize>> = HashMap::new();
-        let mut first = Vec::with_capacity(pieces.len());
-        for (i, (lo, hi)) in boxes.iter().enumerate() {
-            let (x0, y0) = key(cell, lo);
-            let (x1, y1) = key(cell, hi);
-            first.push((x0, y0));
-            for x in x0..=x1 {
-                for y in y0..=y1 {
-                    grid.entry((x, y)).or_default().push(i);
-                }
+        let mut listed = Vec::with_capacity(pieces.len());
+        for (i, seg) in pieces.iter().enumerate() {
+            let (cells, how) = cells_of(cell, seg);
+            for c in cells {
+                grid.entry(c).or_default().push(i);
             }
+            listed.push(how);
         }
         let shapes = pieces.iter().map(Shape::of).collect();
-        Cut { radius, pieces, boxes, first, shapes, cell, grid }
+        Cut { radius, pieces, boxes, listed, shapes, cell, grid }
     }
 
     /// Appends `seg`, cut after every piece so far (indexed at once).
     pub fn push(&mut self, seg: Seg) {
         let i = self.pieces.len();
-        let b = seg.bounds();
-        let (x0, y0) = key(self.cell, &b.0);
-        let (x1, y1) = key(self.cell, &b.1);
-        for x in x0..=x1 {
-            for y in y0..=y1 {
-                self.grid.entry((x, y)).or_default().push(i);
-            }
+        let (cells, how) = cells_of(self.cell, &seg);
+        for c in cells {
+            self.grid.entry(c).or_default().push(i);
         }
-        self.first.push((x0, y0));
-        self.boxes.push(b);
+        self.listed.push(how);
+        self.boxes.push(seg.bounds());
         self.shapes.push(Shape::of(&seg));
         self.pieces.push(seg);
     }
@@ -175,18 +169,14 @@ impl Cut {
     pub fn pop(&mut self) -> Option<Seg> {
         let seg = self.pieces.pop()?;
         let i = self.pieces.len();
-        let b = self.boxes.pop().expect("a box per piece");
-        self.first.pop();
+        self.boxes.pop();
         self.shapes.pop();
-        let (x0, y0) = key(self.cell, &b.0);
-        let (x1, y1) = key(self.cell, &b.1);
-        for x in x0..=x1 {
-            for y in y0..=y1 {
-                if let Some(list) = self.grid.get_mut(&(x, y))
-                    && list.last() == Some(&i)
-                {
-                    list.pop();
-                }
+        self.listed.pop();
+        for c in cells_of(self.cell, &seg).0 {
+            if let Some(list) = self.grid.get_mut(&c)
+                && list.last() == Some(&i)
+            {
+                list.pop();
             }
         }
         Some(seg)
@@ -246,17 +236,25 @@ impl Cut {
         if let Some((lo, hi)) = hull(&screen) {
             let (qx0, qy0) = key(self.cell, &P2::new(lo.x - reach, lo.y - reach));
             let (qx1, qy1) = key(self.cell, &P2::new(hi.x + reach, hi.y + reach));
+            // Pieces listed in parts met already (each piece is taken once).
+            let mut seen: Vec<usize> = Vec::new();
             'cells: for x in qx0..=qx1 {
                 for y in qy0..=qy1 {
                     let Some(list) = self.grid.get(&(x, y)) else { continue };
                     for &j in list.iter().take_while(|&&j| j < old) {
-                        // Each piece once: in the first of its cells inside the range.
-                        let (fx, fy) = self.first[j];
+                        // Each piece once: one listed by its box in the first of its cells
+                        // inside the range, one listed in parts where it is met first.
+                        let first = match self.listed[j] {
+                            Listed::Box((fx, fy)) => (fx.max(qx0), fy.max(qy0)) == (x, y),
+                            Listed::Parts => {
+                                !seen.contains(&j) && {
+                                    seen.push(j);
+                                    true
+                                }
+                            }
+                        };
                         let b = &self.boxes[j];
-                        if (fx.max(qx0), fy.max(qy0)) != (x, y)
-                            || !touches(b)
-                            || !screen.iter().any(|q| boxes_within(b, q, reach))
-                        {
+                        if !first || !touches(b) || !screen.iter().any(|q| boxes_within(b, q, reach)) {
                             continue;
                         }
                         removed_into(p, r, &self.pieces[j], &self.shapes[j], false, &mut all);
@@ -434,6 +432,39 @@ fn boxes_within(a: &(P2, P2), b: &(P2, P2), reach: f64) -> bool {
     let dx = (a.0.x - b.1.x).max(b.0.x - a.1.x).max(0.0);
     let dy = (a.0.y - b.1.y).max(b.0.y - a.1.y).max(0.0);
     dx * dx + dy * dy < reach * reach
+}
+
+/// Most parts a piece is cut into for the grid (its parts are longer than a cell past this).
+const MAX_PARTS: f64 = 1e6;
+
+/// How a piece is listed in the grid: over the cells of its box, whose low corner is the
+/// cell, or (a long line across cells, a wide arc) over the cells its parts' boxes meet.
+#[derive(Clone, Copy, PartialEq)]
+enum Listed {
+    Box((i64, i64)),
+    Parts,
+}
+
+/// The grid cells (each once) where `seg` is listed, and how: those of its box, unless the
+/// box holds many more cells than the piece runs through; then those of the boxes of its
+/// parts, each at most `cell` long (a wide arc's box covers the pocket).
+fn cells_of(cell: f64, seg: &Seg) -> (Vec<(i64, i64)>, Listed) {
+    let rect = |(lo, hi): (P2, P2)| {
+        let ((x0, y0), (x1, y1)) = (key(cell, &lo), key(cell, &hi));
+        (x0..=x1).flat_map(move |x| (y0..=y1).map(move |y| (x, y)))
+    };
+    let b = seg.bounds();
+    let n = (seg.length() / cell).ceil().clamp(1.0, MAX_PARTS);
+    let in_box = ((b.1.x - b.0.x) / cell + 2.0) * ((b.1.y - b.0.y) / cell + 2.0);
+    if in_box <= 4.0 * n + 16.0 {
+        return (rect(b).collect(), Listed::Box(key(cell, &b.0)));
+    }
+    let n = n as usize;
+    let mut out: Vec<(i64, i64)> =
+        (0..n).flat_map(|k| rect(seg.sub(k as f64 / n as f64, (k + 1) as f64 / n as f64).bounds())).collect();
+    out.sort_unstable();
+    out.dedup();
+    (out, Listed::Parts)
 }
 
 fn key(cell: f64, p: &P2) -> (i64, i64) {
