@@ -1020,6 +1020,37 @@ fn plans_past_the_memory_bound_are_refused_up_front() {
     assert!(started.elapsed().as_secs_f64() < 10.0, "refused at once: {:?}", started.elapsed());
 }
 
+/// Issue 20: a plan's work is estimated in engagement samples before any simulation and held
+/// to `--max-work` (a 350 mm pocket, a DXF bulge fuzzed from 0.414 to 100, ran 107 s). The
+/// estimate tracks the samples the plan simulates: within 4x either way on these pockets, so a
+/// bound a quarter of the samples is refused at once and four times them is not.
+#[test]
+fn plans_past_the_work_bound_are_refused_up_front() {
+    let w = Work::new();
+    for (file, strategy) in [("square.csv", "trochoid"), ("box-die.csv", "trochoid"), ("islands2.csv", "adaptive")] {
+        let src = data(&format!("medial-trochoid/{file}"));
+        let src = src.to_str().unwrap();
+        let base = [src, "--radius", "5", "--sample", "1", "--strategy", strategy];
+        let mut a = base.to_vec();
+        a.extend(["--report", "r.json", "-o", "t.csv"]);
+        w.run(BIN, &a, b"").ok();
+        let samples = report(&w, "r.json")["samples"].as_f64().expect("samples");
+        let (low, high) = (format!("{}", samples / 4.0), format!("{}", samples * 4.0));
+        let started = std::time::Instant::now();
+        let mut a = base.to_vec();
+        a.extend(["--max-work", &low, "-o", "low.csv"]);
+        w.run(BIN, &a, b"").fails(2, "engagement samples, more than the bound");
+        assert!(!w.exists("low.csv"));
+        assert!(started.elapsed().as_secs_f64() < 0.5, "{file}: refused at once: {:?}", started.elapsed());
+        let mut a = base.to_vec();
+        a.extend(["--max-work", &high, "-o", "high.csv"]);
+        w.run(BIN, &a, b"").ok();
+        // --analyse counts the given program's samples.
+        let a = [src, "--radius", "5", "--sample", "1", "--analyse", "t.csv", "--max-work", &low, "-o", "g.csv"];
+        w.run(BIN, &a, b"").fails(2, "the analysis of t.csv (--sample 1 mm) needs an estimated");
+    }
+}
+
 /// Issue 20: every numeric option at extreme values, seeded (scripts/fuzz-options.py runs them
 /// all): no panic, exit 0/1/2, one error line, under 20 s and 4 GiB.
 #[test]
@@ -1046,6 +1077,7 @@ fn extreme_option_values_end_in_time_with_one_line() {
         "--force-at",
         "--decimals",
         "--max-memory",
+        "--max-work",
     ];
     w.fuzz_options(BIN, src.to_str().unwrap(), &["--radius", "5", "--sample", "2"], &options, 20, 12);
 }

@@ -42,6 +42,18 @@ pub fn check_memory(need: f64, bound: f64, what: &str, hint: &str) -> Result<()>
     )))
 }
 
+/// Refuses an estimated `need` of work (counted in `unit`, e.g. "engagement samples") beyond
+/// `bound` (`--max-work`), as [`check_memory`] does for memory.
+pub fn check_work(need: f64, bound: f64, unit: &str, what: &str, hint: &str) -> Result<()> {
+    if fits(need, bound) {
+        return Ok(());
+    }
+    let need = if need.is_finite() { format!("an estimated {need:.3e} {unit}") } else { format!("unbounded {unit}") };
+    Err(Error::input(format!(
+        "{what} needs {need}, more than the bound of {bound:.3e} (--max-work): {hint} or raise --max-work"
+    )))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -53,5 +65,13 @@ mod tests {
         assert!(e.to_string().contains("--max-memory") && e.to_string().contains("--step"), "{e}");
         assert!(check_memory(f64::NAN, 1e9, "a", "b").is_err());
         assert!(check_memory(f64::INFINITY, 1e9, "a", "b").is_err());
+    }
+
+    #[test]
+    fn work_past_the_bound_or_not_a_number_is_refused() {
+        assert!(check_work(1e5, 1e5, "samples", "a", "b").is_ok());
+        let e = check_work(2e5, 1e5, "samples", "the plan (--sample)", "coarsen --sample").unwrap_err();
+        assert!(e.to_string().contains("2.000e5 samples") && e.to_string().contains("--max-work"), "{e}");
+        assert!(check_work(f64::NAN, 1e5, "samples", "a", "b").is_err());
     }
 }

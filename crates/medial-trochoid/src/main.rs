@@ -175,6 +175,11 @@ struct Args {
     /// --pitch, --sagitta and the layers before planning; larger plans are refused (exit 2).
     #[arg(long, default_value_t = camkit::budget::DEFAULT_MEMORY_MB, value_name = "MB")]
     max_memory: u64,
+    /// Largest work of a plan or an --analyse run in engagement samples (60 to 190 µs of CPU
+    /// each on the demo pockets), estimated from the pocket, --step, --sample and --pitch (or
+    /// the given toolpath's length over --sample) before any simulation; more is refused (exit 2).
+    #[arg(long, default_value_t = medial_trochoid::budget::DEFAULT_WORK, value_name = "N")]
+    max_work: f64,
 }
 
 fn after_help() -> String {
@@ -365,6 +370,19 @@ fn run(args: Args) -> Result<()> {
             cli::short(args.sagitta)
         ),
         "coarsen --step, --sample, --pitch or --sagitta, use fewer layers",
+    )?;
+    camkit::budget::check_work(
+        medial_trochoid::budget::work(&regions, &settings),
+        positive(args.max_work, "--max-work")?,
+        "engagement samples",
+        &format!(
+            "the plan (--step {} mm, --sample {} mm, --trochoid-radius {} mm{})",
+            cli::short(step),
+            cli::short(settings.sample),
+            cli::short(rt),
+            args.pitch.map(|p| format!(", --pitch {} mm", cli::short(p))).unwrap_or_default(),
+        ),
+        "coarsen --step, --sample or --pitch",
     )?;
     if args.strategy == Strategy::Adaptive {
         let planning = Settings {
@@ -783,6 +801,21 @@ fn analyse_given(
             Error::input("no feed move at the toolpath's lowest z: nothing to analyse").at(Location::file(&name))
         );
     }
+    let samples = medial_trochoid::budget::given_samples(&given.program, s.sample);
+    let what = format!("the analysis of {name} (--sample {} mm)", cli::short(s.sample));
+    camkit::budget::check_memory(
+        medial_trochoid::budget::given_memory(samples),
+        camkit::budget::bytes_of(args.max_memory),
+        &what,
+        "coarsen --sample",
+    )?;
+    camkit::budget::check_work(
+        samples,
+        positive(args.max_work, "--max-work")?,
+        "engagement samples",
+        &what,
+        "coarsen --sample",
+    )?;
     let progress = args.io.progress(0, "simulating the given toolpath");
     let a = medial_trochoid::analyse(given.program.clone(), s, regions);
     progress.finish();
