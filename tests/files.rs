@@ -99,6 +99,25 @@ fn bad_paths_are_bad_input() {
         .fails(2, "Not a directory");
 }
 
+/// D16: with standard output closed a filter's output would be lost (Rust's runtime opens
+/// /dev/null in its place): refused, exit 2, one line; to `-o` or to /dev/null it runs as usual.
+#[test]
+fn a_closed_stdout_is_refused_not_lost() {
+    let w = Work::new();
+    w.write("square.csv", SQUARE);
+    let shell = |redirect: &str| {
+        let cmd = format!("'{}' square.csv --radius 1 --side left {redirect}", bin("offset").display());
+        let out = Command::new("bash").args(["-c", &cmd]).current_dir(w.path(".")).output().expect("bash");
+        (out.status.code(), String::from_utf8_lossy(&out.stderr).into_owned())
+    };
+    let (status, err) = shell(">&-");
+    assert_eq!(status, Some(2), "{err}");
+    assert!(err.contains("cannot write stdout: it was closed") && err.trim_end().lines().count() == 1, "{err}");
+    assert_eq!(shell(">/dev/null"), (Some(0), String::new()));
+    assert_eq!(shell("-o out.csv >&-"), (Some(0), String::new()));
+    assert!(w.read("out.csv").starts_with("path,"));
+}
+
 /// Old Mac line ends after a comment, lines of spaces and a byte order mark read like the plain
 /// table; a G-code file after a byte order mark reads like the plain one.
 #[test]

@@ -7,6 +7,7 @@ use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 
 pub mod spool;
+pub mod stdout;
 pub use spool::{DiskFailure, Get, Record, RecordSpool, Records, Share, Spool, Spooled, View};
 
 /// The temporary files outputs are being written to: an interrupt removes them (see
@@ -252,6 +253,7 @@ impl Stream {
                         std::io::copy(&mut file, &mut dest).map_err(|e| Error::io(e, &shown))?;
                     }
                     None => {
+                        stdout_open()?;
                         let mut out = std::io::stdout().lock();
                         std::io::copy(&mut file, &mut out)
                             .and_then(|_| out.flush())
@@ -299,6 +301,14 @@ impl Restart for Stream {
     }
 }
 
+/// Refuses to deliver output to a standard output that was closed at start-up.
+fn stdout_open() -> Result<()> {
+    if stdout::was_closed() {
+        return Err(Error::input("cannot write stdout: it was closed when the filter started (give -o FILE)"));
+    }
+    Ok(())
+}
+
 /// Output collected in memory and delivered only on [`Output::commit`]: to a file through a
 /// temporary file renamed into place, or to standard output in one write. A run that fails
 /// before committing leaves no file and prints nothing.
@@ -321,6 +331,7 @@ impl Output {
         match &self.path {
             Some(path) => write_atomic(path, &self.buf),
             None => {
+                stdout_open()?;
                 let mut out = std::io::stdout().lock();
                 out.write_all(&self.buf).and_then(|_| out.flush()).map_err(|e| Error::io(e, "stdout"))
             }
