@@ -1051,6 +1051,19 @@ fn plans_past_the_work_bound_are_refused_up_front() {
     }
 }
 
+/// Issue 20: a pocket past ±3e7 mm is refused naming its path and line (an SVG island fuzzed to
+/// 1e9 mm planned 8 times slower from round-off, past 20 s of CPU); 2e7 mm plans (tests/offset.rs).
+#[test]
+fn pockets_past_the_coordinate_bound_are_refused() {
+    let w = Work::new();
+    let far = "path,move,x,y\n1,line,0,0\n1,line,60,0\n1,line,60,40\n1,line,0,40\n1,line,0,0\n\
+               2,line,20,50000010\n2,line,20,50000020\n2,line,40,50000020\n2,line,40,50000010\n2,line,20,50000010\n";
+    w.write("far.csv", far);
+    w.run(BIN, &["far.csv", "--radius", "3", "-o", "o.csv"], b"")
+        .fails(2, "far.csv:7: path 2 reaches 5.000002e7 mm, beyond ±3e7 mm");
+    assert!(!w.exists("o.csv"));
+}
+
 /// Issue 20: every numeric option at extreme values, seeded (scripts/fuzz-options.py runs them
 /// all): no panic, exit 0/1/2, one error line, under 20 s and 4 GiB.
 #[test]

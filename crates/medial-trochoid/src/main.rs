@@ -343,6 +343,18 @@ fn run(args: Args) -> Result<()> {
     if sources.is_empty() {
         return Err(Error::input("no closed contour in the input").at(Location::file(&name)));
     }
+    for src in &sources {
+        let far =
+            src.contour.bounds().map_or(0.0, |(lo, hi)| lo.x.abs().max(lo.y.abs()).max(hi.x.abs()).max(hi.y.abs()));
+        if !(far <= medial_trochoid::COORD_LIMIT) {
+            return Err(Error::input(format!(
+                "path {} reaches {far:e} mm, beyond ±{:e} mm where round-off undoes the engagement simulation's 1e-6 mm margins: move the pocket towards the origin",
+                src.path,
+                medial_trochoid::COORD_LIMIT
+            ))
+            .at(Location::file(&name).line(src.line)));
+        }
+    }
     let (regions, _turned) = contour_table::pocket_regions(&sources, &name)?;
     if let Some(given) = &args.analyse {
         return analyse_given(given, &regions, &settings, &args, started);
