@@ -346,7 +346,7 @@ fn run(args: Args) -> Result<()> {
     for src in &sources {
         let far =
             src.contour.bounds().map_or(0.0, |(lo, hi)| lo.x.abs().max(lo.y.abs()).max(hi.x.abs()).max(hi.y.abs()));
-        if !(far <= medial_trochoid::COORD_LIMIT) {
+        if far.is_nan() || far > medial_trochoid::COORD_LIMIT {
             return Err(Error::input(format!(
                 "path {} reaches {far:e} mm, beyond ±{:e} mm where round-off undoes the engagement simulation's 1e-6 mm margins: move the pocket towards the origin",
                 src.path,
