@@ -321,16 +321,23 @@ fn along(centre: &P3, axis: &V3) -> Pose {
 /// Triangles of a parametric surface `at(u, v)` over `[u0, u1, v0, v1]`: a uniform grid refined
 /// until the surface at every cell's centre and edge midpoints lies within `chord` of the cell's
 /// two triangles (their planes), the triangles turned to agree with the outward normal `normal`
-/// (`flip` reverses it). Returns the triangles and the largest deviation seen.
+/// (`flip` reverses it). Returns the triangles and the largest deviation seen, the grid's
+/// vertices taken from `left`; or, when a grid would need more vertices than `left` holds, that
+/// number (before it is built: a finely bent patch at a tight chord makes 2 M triangles).
 fn surface_triangles(
     [u0, u1, v0, v1]: [f64; 4],
     at: &dyn Fn(f64, f64) -> P3,
     normal: &dyn Fn(f64, f64) -> Option<V3>,
     flip: bool,
     chord: f64,
-) -> (Vec<[P3; 3]>, f64) {
+    left: &std::cell::Cell<usize>,
+) -> Result<(Vec<[P3; 3]>, f64), usize> {
     let mut n = 8usize;
     loop {
+        let need = (n + 1) * (n + 1);
+        if need > left.get() {
+            return Err(need);
+        }
         let uv = |i: f64, j: f64| (u0 + (u1 - u0) * i / n as f64, v0 + (v1 - v0) * j / n as f64);
         let grid = |i: usize, j: usize| {
             let (u, v) = uv(i as f64, j as f64);
@@ -361,7 +368,8 @@ fn surface_triangles(
             }
         }
         if worst <= chord || n >= 1024 {
-            return (tris, worst);
+            left.set(left.get() - need);
+            return Ok((tris, worst));
         }
         n *= 2;
     }
@@ -491,6 +499,9 @@ impl Solid {
                 "within {chord} mm the faces' triangles need at least {total} vertices (the largest, surface {name}, {n}), more than the {MAX_VERTICES} a model's may have: the faces are too large or too finely bent for the check"
             ));
         }
+        // The vertices left to the surfaces tessellated by their parametrisation (patches,
+        // cones, tori, bounded cylinders), counted as their grids are refined.
+        let left = std::cell::Cell::new(MAX_VERTICES - total);
         let mut solid =
             Solid { pieces: Vec::new(), hollows: Vec::new(), rods: Vec::new(), chord: 0.0, open: Vec::new() };
         for s in &model.surfaces {
@@ -502,7 +513,13 @@ impl Solid {
                                domain: [f64; 4],
                                closed: bool|
              -> Result<(PartPiece, f64), String> {
-                let (tris, dev) = surface_triangles(domain, at, normal, s.flip, chord);
+                let (tris, dev) = surface_triangles(domain, at, normal, s.flip, chord, &left).map_err(|need| {
+                    format!(
+                        "within {chord} mm the triangles of surface {} need {need} vertices, more than the {} left of the {MAX_VERTICES} a model's may have: the surfaces are too large or too finely bent for the check",
+                        s.name,
+                        left.get()
+                    )
+                })?;
                 Ok((mesh_piece(&s.name, tris.into_iter().map(|t| t.map(place)), closed && !s.flip)?.0, dev))
             };
             let mut add = |(piece, dev): (PartPiece, f64)| {
@@ -974,11 +991,34 @@ mod tests {
         let solid = Solid::of(&m, 0.01).unwrap();
         assert!(solid.chord_error() <= 0.01 && solid.chord_error() > 0.0, "{}", solid.chord_error());
         let Geometry::Patch(p) = &m.surfaces[0].geometry else { unreachable!() };
-        let (tris, _) = surface_triangles(p.domain(), &|u, v| p.eval(u, v).s, &|u, v| p.normal(u, v), false, 0.01);
+        let left = std::cell::Cell::new(MAX_VERTICES);
+        let (tris, _) =
+            surface_triangles(p.domain(), &|u, v| p.eval(u, v).s, &|u, v| p.normal(u, v), false, 0.01, &left).unwrap();
         for t in tris.iter().step_by(7) {
             let centre = P3::from((t[0].coords + t[1].coords + t[2].coords) / 3.0);
             assert!(m.nearest(&centre).distance <= 0.01 + 1e-9);
             assert!(m.nearest(&t[0]).distance <= 1e-6);
         }
+        // The grid's vertices are taken from those left; a grid past them is refused unbuilt.
+        let n = MAX_VERTICES - left.get();
+        assert!(n >= 81 && n <= 1025 * 1025 && (n as f64).sqrt().fract() == 0.0, "{n}");
+        let few = std::cell::Cell::new(n - 1);
+        let need = surface_triangles(p.domain(), &|u, v| p.eval(u, v).s, &|u, v| p.normal(u, v), false, 0.01, &few);
+        assert_eq!(need.unwrap_err(), n);
+        assert_eq!(few.get(), n - 1);
+        // So is a model of patches that need more in all than a model may have.
+        let wiggly: Vec<Vec<P3>> = (0..6)
+            .map(|i| {
+                (0..6)
+                    .map(|j| P3::new(20.0 * i as f64, 20.0 * j as f64, if (i + j) % 2 == 0 { 20.0 } else { -20.0 }))
+                    .collect()
+            })
+            .collect();
+        let mut m = model(Geometry::Patch(crate::model::patch::BSpline::new(&wiggly, [3, 3], None, None)), false);
+        let one = m.surfaces[0].clone();
+        m.surfaces.push(one.clone());
+        m.surfaces.push(one);
+        let e = Solid::of(&m, 1e-5).err().expect("refused");
+        assert!(e.contains("left of the 2000000 a model's may have"), "{e}");
     }
 }
