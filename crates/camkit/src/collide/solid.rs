@@ -1001,7 +1001,7 @@ mod tests {
         }
         // The grid's vertices are taken from those left; a grid past them is refused unbuilt.
         let n = MAX_VERTICES - left.get();
-        assert!(n >= 81 && n <= 1025 * 1025 && (n as f64).sqrt().fract() == 0.0, "{n}");
+        assert!((81..=1025 * 1025).contains(&n) && (n as f64).sqrt().fract() == 0.0, "{n}");
         let few = std::cell::Cell::new(n - 1);
         let need = surface_triangles(p.domain(), &|u, v| p.eval(u, v).s, &|u, v| p.normal(u, v), false, 0.01, &few);
         assert_eq!(need.unwrap_err(), n);
