@@ -370,30 +370,27 @@ fn run(args: Args) -> Result<()> {
         ));
     }
     let (z0, layer_count, layer_depth) = layering(job.as_ref(), sources[0].z, args.layers, args.layer_depth)?;
-    camkit::budget::check_memory(
-        medial_trochoid::budget::memory(&regions, &settings, layer_count),
-        camkit::budget::bytes_of(args.max_memory),
-        &format!(
-            "the plan (--step {} mm, --sample {} mm, {layer_count} layers, --trochoid-radius {} mm{}, --sagitta {} mm)",
+    // The plan's spacings as both bounds name them (`mid` after the sample, `tail` at the end).
+    let plan_named = |mid: &str, tail: &str| {
+        format!(
+            "the plan (--step {} mm, --sample {} mm{mid}, --trochoid-radius {} mm{}{tail})",
             cli::short(step),
             cli::short(settings.sample),
             cli::short(rt),
             args.pitch.map(|p| format!(", --pitch {} mm", cli::short(p))).unwrap_or_default(),
-            cli::short(args.sagitta)
-        ),
+        )
+    };
+    camkit::budget::check_memory(
+        medial_trochoid::budget::memory(&regions, &settings, layer_count),
+        camkit::budget::bytes_of(args.max_memory),
+        &plan_named(&format!(", {layer_count} layers"), &format!(", --sagitta {} mm", cli::short(args.sagitta))),
         "coarsen --step, --sample, --pitch or --sagitta, use fewer layers",
     )?;
     camkit::budget::check_work(
         medial_trochoid::budget::work(&regions, &settings),
         positive(args.max_work, "--max-work")?,
         "engagement samples",
-        &format!(
-            "the plan (--step {} mm, --sample {} mm, --trochoid-radius {} mm{})",
-            cli::short(step),
-            cli::short(settings.sample),
-            cli::short(rt),
-            args.pitch.map(|p| format!(", --pitch {} mm", cli::short(p))).unwrap_or_default(),
-        ),
+        &plan_named("", ""),
         "coarsen --step, --sample or --pitch",
     )?;
     if args.strategy == Strategy::Adaptive {
