@@ -323,6 +323,11 @@ fn box_die_whole_program_holds_the_threshold_links_included() {
     let out = rows(&w.read("t.csv"));
     let worst = out.iter().filter(|(t, ..)| t != "entry").filter_map(|r| r.1).fold(0.0, f64::max);
     assert!(worst <= 40.0005, "{worst}");
+    // Runs that start on ground earlier runs cleared have no entry loop: each run has an entry
+    // chain (its rapid row tagged entry) or is counted as started on cleared ground.
+    let idle = r["entries_on_cleared_ground"].as_u64().unwrap();
+    let entries = w.read("t.csv").lines().filter(|l| l.contains(",rapid,") && l.contains(",entry,")).count();
+    assert!(idle >= 1 && entries as u64 + idle == r["trochoid_runs"].as_u64().unwrap(), "{entries} entries, {r}");
     // The time estimate is the written feeds: the rows' own lengths and feeds give it again.
     let f = |k: &str| r[k].as_f64().unwrap_or_else(|| panic!("{k} in {r}"));
     let again = minutes_of(&w.read("t.csv"));
@@ -1081,6 +1086,7 @@ fn extreme_option_values_end_in_time_with_one_line() {
         "--sample",
         "--layers",
         "--layer-depth",
+        "--ramp-angle",
         "--resolution",
         "--sagitta",
         "--spindle",
@@ -1152,4 +1158,72 @@ fn adaptive_clears_a_round_pocket_in_one_spiral_and_the_default_strategy_is_unch
     w.run(BIN, &[src, "--radius", "5", "-o", "a.csv"], b"").ok();
     w.run(BIN, &[src, "--radius", "5", "--strategy", "trochoid", "-o", "b.csv"], b"").ok();
     assert_eq!(w.read("a.csv"), w.read("b.csv"));
+}
+
+/// The helical entries of both strategies, two layers of 10 mm: each entry chain descends one
+/// layer no steeper than --ramp-angle (row by row, on the written rows), then one whole loop at
+/// the layer's depth that ends where it started, before any other row of that layer (the 2D
+/// simulation counts the entry's disk cleared to the floor: the descending loops alone leave a
+/// ramp there). A ramp angle of 0 or 90° is refused.
+#[test]
+fn entries_ramp_at_their_angle_and_loop_once_at_the_layer_depth() {
+    let w = Work::new();
+    let src = data("medial-trochoid/square.csv");
+    for strategy in ["trochoid", "adaptive"] {
+        let args = [src.to_str().unwrap(), "--radius", "5", "--sample", "1", "--strategy", strategy];
+        let layers = ["--layers", "2", "--layer-depth", "10", "--ramp-angle", "3", "-o", "t.csv"];
+        w.run(BIN, &[&args[..], &layers[..]].concat(), b"").ok();
+        let table = w.read("t.csv");
+        let mut lines = table.lines();
+        let h: Vec<&str> = lines.next().unwrap().split(',').collect();
+        let col = |n: &str| h.iter().position(|c| *c == n).unwrap();
+        let (x, y, z, tag, mv) = (col("x"), col("y"), col("z"), col("tag"), col("move"));
+        let (xc, yc) = (col("xc"), col("yc"));
+        let recs: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
+        let num = |r: &[&str], k: usize| r[k].parse::<f64>().unwrap();
+        // The xy length of the move into row `b` from row `a`: its arc about (xc, yc) or chord.
+        let run = |a: &[&str], b: &[&str]| {
+            let chord = (num(b, x) - num(a, x)).hypot(num(b, y) - num(a, y));
+            if b[mv] != "ccw" && b[mv] != "cw" {
+                return chord;
+            }
+            let r = (num(b, x) - num(b, xc)).hypot(num(b, y) - num(b, yc));
+            2.0 * r * (chord / (2.0 * r)).min(1.0).asin()
+        };
+        let (mut chains, mut k) = (0, 0);
+        while k < recs.len() {
+            if !(recs[k][mv] == "rapid" && recs[k][tag] == "entry") {
+                k += 1;
+                continue;
+            }
+            // The rapid above the layer, then the chain's entry rows.
+            let top = num(&recs[k], z);
+            let mut j = k + 1;
+            while j < recs.len() && recs[j][tag] == "entry" && recs[j][mv] != "rapid" {
+                j += 1;
+            }
+            let chain = &recs[k..j];
+            let floor = num(&chain[chain.len() - 1], z);
+            assert!((top - floor - 10.0).abs() < 1e-9, "{strategy}: entry from {top} to {floor}");
+            for p in chain.windows(2) {
+                let (run, drop) = (run(&p[0], &p[1]), num(&p[0], z) - num(&p[1], z));
+                let steepest = run * 3f64.to_radians().tan() + 1e-9;
+                assert!(drop >= -1e-12 && drop <= steepest, "{strategy}: {drop} over {run}");
+            }
+            // The rows at the floor: one whole loop, closed (the last descending row is its start).
+            let first_flat = chain.iter().position(|r| (num(r, z) - floor).abs() < 1e-12).unwrap();
+            let flat = &chain[first_flat..];
+            let length: f64 = flat.windows(2).map(|p| run(&p[0], &p[1])).sum();
+            let (a, b) = (&flat[0], &flat[flat.len() - 1]);
+            assert!((num(a, x) - num(b, x)).hypot(num(a, y) - num(b, y)) < 1e-9, "{strategy}: open loop");
+            assert!(length > 5.0, "{strategy}: the loop at depth is {length} mm");
+            chains += 1;
+            k = j;
+        }
+        assert!(chains >= 2, "{strategy}: {chains} entries over two layers");
+    }
+    for bad in ["0", "90"] {
+        w.run(BIN, &[src.to_str().unwrap(), "--radius", "5", "--ramp-angle", bad, "-o", "o.csv"], b"")
+            .fails(2, "--ramp-angle must be over 0 and under 90 degrees");
+    }
 }

@@ -40,6 +40,7 @@ fn main() {
         sample: 0.5,
         medial: MedialOptions::default(),
         feed: FeedModel { spindle: 4800.0, teeth: 6.0, chip: 0.03, fz_max: 0.1, force_at: Some(40.0) },
+        entry: medial_trochoid::program::Entry::FLAT,
     };
     let t0 = Instant::now();
     let p = plan(&regions, &s).expect("a plan");

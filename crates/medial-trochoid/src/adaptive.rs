@@ -322,8 +322,8 @@ pub fn plan_adaptive(regions: &[Region], s: &Settings, unit: Option<f64>) -> Res
             let room = (0.5 * s.radius).min(cl - w.wall - 2.0 * unit);
             let rh = w.unit.map_or(room, |u| (room / u).floor() * u);
             let helix = Contour::circle(c0, rh, 0.0, true);
-            for (k, seg) in helix.segs().enumerate() {
-                out.program.moves.push(Move { seg, tag: Tag::Entry, retract_before: k == 0 });
+            out.program.push_entry(&helix, &s.entry);
+            for seg in helix.segs() {
                 cutting.push(seg);
                 m.clear(&seg, w.r);
             }

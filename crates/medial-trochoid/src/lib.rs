@@ -35,7 +35,7 @@ use camkit::geom::P2;
 use engagement::Cut;
 use feed::{FeedModel, Load};
 use medial::{Medial, MedialOptions, medial_axis};
-use program::{Program, Tag, point_clearance};
+use program::{Entry, Program, Tag, point_clearance};
 use rayon::prelude::*;
 use std::collections::HashMap;
 
@@ -64,6 +64,8 @@ pub struct Settings {
     pub medial: MedialOptions,
     /// Feed model for the time estimate.
     pub feed: FeedModel,
+    /// How entry loops take the tool down.
+    pub entry: Entry,
 }
 
 #[cfg(test)]
@@ -82,6 +84,7 @@ impl Settings {
             sample: 0.5,
             medial: MedialOptions { resolution: 1e-6, sagitta: 1e-3, chord_error: 1e-3 },
             feed: FeedModel { spindle: 4800.0, teeth: 6.0, chip: 0.03, fz_max: 0.1, force_at: Some(40.0) },
+            entry: Entry::FLAT,
         }
     }
 }
@@ -146,6 +149,9 @@ pub struct Plan {
     pub rests: Vec<corner::Rest>,
     /// Links of the trochoids-first program that went over the threshold, replaced.
     pub relinks: Vec<relink::Relink>,
+    /// Entries of runs that met no material (earlier runs had cleared their disk), dropped: the
+    /// run starts with a plunge on cleared ground ([`drop_idle_entries`]).
+    pub idle_entries: usize,
     /// Rounds of repair: the whole-program check found material over the threshold and
     /// the medial points within R of it were made dangerous too (the plan made again).
     pub repair_rounds: usize,
@@ -511,7 +517,8 @@ fn plan_in(regions: &[Region], walls: &[Region], s: &Settings) -> Result<Plan, P
     {
         (built, stretches, repair_rounds) = (b, st, rounds);
     }
-    let b = &built.trochoidal;
+    let (trochoidal, idle_entries) = drop_idle_entries(built.trochoidal, s, walls);
+    let b = &trochoidal;
     let left_over = cutting_over(&b.program, &b.samples, &b.engagement, s.threshold)
         .map(|((i, t), e)| (b.program.moves[i].seg.point_at(t), e))
         .collect::<Vec<_>>();
@@ -521,7 +528,8 @@ fn plan_in(regions: &[Region], walls: &[Region], s: &Settings) -> Result<Plan, P
         passes: built.passes,
         medial,
         offset_only,
-        trochoidal: built.trochoidal,
+        trochoidal,
+        idle_entries,
         danger: stretches.danger,
         runs: stretches.runs,
         uncleared: stretches.uncleared,
@@ -667,7 +675,7 @@ fn build(
         if before.is_some_and(|(_, kept)| k == kept) {
             same = troch.moves.len();
         }
-        trochoid::push_varying(&mut troch, &run.points, &run.radii, &run.pitches);
+        trochoid::push_varying(&mut troch, &run.points, &run.radii, &run.pitches, &s.entry);
     }
     let (passes, rests) = round_walls(passes, &troch, s);
     let mut first = true;
@@ -718,6 +726,53 @@ fn build(
     }
     debug_assert!(trochoidal.program.continuous(), "a chain of the program jumps");
     Built { passes, rests, trochoidal, relinks }
+}
+
+/// Largest engagement (degrees) at which an entry counts as meeting no material.
+const IDLE_ENTRY_DEG: f64 = 1e-6;
+
+/// `a` without the entries that meet no material at any sample (earlier runs of the layer
+/// cleared their disk to its depth): their runs start with a plunge on cleared ground instead,
+/// as a relink's retract does, not a helix at the slot feed down through air. `a` as it was if
+/// the re-simulation then finds more over the threshold (a sliver between samples). With the
+/// count dropped.
+fn drop_idle_entries(a: Analysed, s: &Settings, walls: &[Region]) -> (Analysed, usize) {
+    let moves = &a.program.moves;
+    let mut worst = vec![0.0f64; moves.len()];
+    for (&(i, _), &e) in a.samples.iter().zip(&a.engagement) {
+        worst[i] = worst[i].max(e);
+    }
+    let mut keep = Program::default();
+    let (mut dropped, mut first) = (0, None);
+    let mut i = 0;
+    while i < moves.len() {
+        let mut j = i + 1;
+        if moves[i].tag == Tag::Entry && moves[i].retract_before {
+            while j < moves.len() && moves[j].tag == Tag::Entry && !moves[j].retract_before {
+                j += 1;
+            }
+            if worst[i..j].iter().all(|&e| e <= IDLE_ENTRY_DEG) {
+                first.get_or_insert(keep.moves.len());
+                dropped += 1;
+                if let Some(next) = moves.get(j) {
+                    let mut start = *next;
+                    start.retract_before = true;
+                    keep.moves.push(start);
+                    j += 1;
+                }
+                i = j;
+                continue;
+            }
+        }
+        keep.moves.extend_from_slice(&moves[i..j]);
+        i = j;
+    }
+    let Some(first) = first else { return (a, 0) };
+    let b = analyse_after(keep, s, walls, &a, first);
+    if (b.over, b.over_links) > (a.over, a.over_links) || b.max_cutting > a.max_cutting + ENGAGEMENT_ROUNDOFF_DEG {
+        return (a, 0);
+    }
+    (b, dropped)
 }
 
 /// Indices of the links of `a` with a sample over `threshold` beyond round-off, in order.

@@ -16,11 +16,15 @@ use clap::{Parser, ValueEnum};
 use medial_trochoid::breakdown::Breakdown;
 use medial_trochoid::feed::FeedModel;
 use medial_trochoid::medial::MedialOptions;
-use medial_trochoid::program::Tag;
+use medial_trochoid::program::{Entry, Tag};
 use medial_trochoid::{Analysed, ENGAGEMENT_ROUNDOFF_DEG, Settings, plan, plan_leaving_uncut, plot};
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Instant;
+
+/// Ramp angle of the helical entries without --ramp-angle or a setup's (degrees): FreeCAD's
+/// adaptive clearing's default helix angle.
+const DEFAULT_RAMP_DEG: f64 = 5.0;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
 enum Which {
@@ -100,6 +104,12 @@ struct Args {
     /// layer's bottom; with --setup, the most a layer may be.
     #[arg(long, default_value_t = 0.0, value_name = "MM")]
     layer_depth: f64,
+    /// Ramp angle of the helical entries (degrees, over 0 and under 90): an entry loop descends
+    /// the layer's depth at this angle over as many loops as that takes, then one more loop is
+    /// cut at the layer's depth (none descends without a layer depth); default the setup's
+    /// plunge.ramp_angle, else 5.
+    #[arg(long, value_name = "DEG")]
+    ramp_angle: Option<f64>,
     /// Which program to write.
     #[arg(long, value_enum, default_value_t = Which::Trochoid)]
     program: Which,
@@ -194,7 +204,10 @@ fn after_help() -> String {
     s.push_str(
         "Output rows are samples along the tool-centre path (at most --sample mm apart); tag is entry (helical\n",
     );
-    s.push_str("entry loop of a trochoid run), trochoid, contour or link; each chain starts with a rapid row.\n");
+    s.push_str(
+        "entry: loops down one layer at --ramp-angle, then one at depth), trochoid, contour or link; each chain\n",
+    );
+    s.push_str("starts with a rapid row.\n");
     s.push_str(
         "--strategy adaptive writes entry (helix), contour (the adaptive passes, straight steps) and link rows;\n",
     );
@@ -296,7 +309,11 @@ fn run(args: Args) -> Result<()> {
             cli::short(args.resolution)
         )));
     }
-    let settings = Settings {
+    let ramp_deg = args.ramp_angle.or(job.as_ref().and_then(|j| j.ramp_angle)).unwrap_or(DEFAULT_RAMP_DEG);
+    if !(ramp_deg > 0.0 && ramp_deg < 90.0) {
+        return Err(Error::input(format!("--ramp-angle must be over 0 and under 90 degrees, got {ramp_deg}")));
+    }
+    let mut settings = Settings {
         radius: r,
         step,
         threshold,
@@ -328,6 +345,8 @@ fn run(args: Args) -> Result<()> {
                 }
             },
         },
+        // Set from the layers below, once they are known.
+        entry: Entry::FLAT,
     };
     let contour_opts = args.contours.options(false)?;
     let input = Input::open(&args.io.input)?;
@@ -370,6 +389,7 @@ fn run(args: Args) -> Result<()> {
         ));
     }
     let (z0, layer_count, layer_depth) = layering(job.as_ref(), sources[0].z, args.layers, args.layer_depth)?;
+    settings.entry = Entry { drop: layer_depth, ramp_deg };
     // The plan's spacings as both bounds name them (`mid` after the sample, `tail` at the end).
     let plan_named = |mid: &str, tail: &str| {
         format!(
@@ -609,6 +629,7 @@ fn run(args: Args) -> Result<()> {
             .set("relinked", plan.relinks.len())
             .set("relinked_by_retract", plan.relinks.iter().filter(|l| l.retract).count())
             .set("relink_standing_engagement_deg", plan.relinks.iter().map(|l| l.standing_deg).collect::<Vec<_>>())
+            .set("entries_on_cleared_ground", plan.idle_entries)
             .set("samples", w.samples.len())
             .set("smallest_wall_clearance_mm", w.wall_clearance)
             .set("no_gouge", gouge.is_none())
@@ -937,8 +958,10 @@ fn range(v: impl Iterator<Item = f64>) -> Vec<f64> {
     if lo <= hi { vec![lo, hi] } else { Vec::new() }
 }
 
-/// For each move, where it starts along its helical entry loop and how much of the loop it
-/// is (fractions of the loop's length; zeros for other moves).
+/// For each move, where it starts along its helical entry's descent and how much of the descent
+/// it is (fractions of the descent's length; zeros for other moves). An entry of several loops
+/// (a chain of entry moves that comes back to its start before its end: [`Entry::loops`])
+/// descends over all but its last loop, which is cut at the layer's depth (fraction 1, none).
 fn helix_fractions(a: &Analysed) -> Vec<(f64, f64)> {
     let moves = &a.program.moves;
     let mut out = vec![(0.0, 0.0); moves.len()];
@@ -952,13 +975,18 @@ fn helix_fractions(a: &Analysed) -> Vec<(f64, f64)> {
         while j < moves.len() && moves[j].tag == Tag::Entry && !moves[j].retract_before {
             j += 1;
         }
-        let total: f64 = moves[i..j].iter().map(|m| m.seg.length()).sum();
+        let start = moves[i].seg.start();
+        let per_loop =
+            (i..j).position(|k| (moves[k].seg.end() - start).norm() <= camkit::tol::POINT_EPS).map_or(j - i, |k| k + 1);
+        let down = if j - i > per_loop { j - per_loop } else { j };
+        let total: f64 = moves[i..down].iter().map(|m| m.seg.length()).sum();
         let mut cum = 0.0;
-        for k in i..j {
+        for k in i..down {
             let l = moves[k].seg.length() / total;
             out[k] = (cum, l);
             cum += l;
         }
+        out[down..j].iter_mut().for_each(|f| *f = (1.0, 0.0));
         i = j;
     }
     out
@@ -997,7 +1025,9 @@ fn to_table(a: &Analysed, z0: f64, layers: usize, depth: f64) -> Table {
             let piece = m.seg.sub(last_t, tt);
             let q = piece.end();
             let (f0, df) = helix[i];
-            let zq = if m.tag == Tag::Entry { z + depth * (1.0 - f0 - df * tt) } else { z };
+            // The descent's share still to go, exactly 0 at its end (not the sum's roundoff).
+            let to_go = 1.0 - f0 - df * tt;
+            let zq = if m.tag == Tag::Entry && to_go > 1e-9 { z + depth * to_go } else { z };
             let mut row = Row::at(path, P3::new(q.x, q.y, zq));
             if let Seg::Arc(arc) = piece {
                 row.mv = if arc.ccw() { Move::Ccw } else { Move::Cw };

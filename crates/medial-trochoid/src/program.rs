@@ -31,6 +31,34 @@ impl Tag {
     }
 }
 
+/// How an entry loop takes the tool down: `drop` mm (the layer's depth; 0 when no stock top is
+/// known, the loop then cut flat at the layer) at `ramp_deg` degrees along the loop, as many
+/// loops as that takes, then one more loop flat at the layer so that the disk it sweeps is
+/// cleared to the layer's depth everywhere (the descending loops leave a ramp on the floor,
+/// which the 2D simulation counts as cleared).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Entry {
+    /// Depth the entry descends (mm).
+    pub drop: f64,
+    /// Ramp angle along the loop (degrees, over 0 and under 90).
+    pub ramp_deg: f64,
+}
+
+impl Entry {
+    /// No descent: one loop at the layer.
+    pub const FLAT: Entry = Entry { drop: 0.0, ramp_deg: 5.0 };
+
+    /// Loops of length `loop_mm` an entry is cut in: the descending ones and the one at depth
+    /// (one loop when there is no descent).
+    pub fn loops(&self, loop_mm: f64) -> usize {
+        if self.drop <= 0.0 || loop_mm <= 0.0 {
+            return 1;
+        }
+        let per_loop = loop_mm * self.ramp_deg.to_radians().tan();
+        (self.drop / per_loop - 1e-9).ceil().max(1.0) as usize + 1
+    }
+}
+
 /// One move of the tool centre.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Move {
@@ -54,6 +82,14 @@ impl Program {
     pub fn push_contour(&mut self, c: &Contour, tag: Tag, retract: bool) {
         for (k, seg) in c.segs().enumerate() {
             self.moves.push(Move { seg, tag, retract_before: retract && k == 0 });
+        }
+    }
+
+    /// Appends the entry loop `c` as [`Entry::loops`] loops tagged entry, a retract before the
+    /// first.
+    pub fn push_entry(&mut self, c: &Contour, entry: &Entry) {
+        for k in 0..entry.loops(c.length()) {
+            self.push_contour(c, Tag::Entry, k == 0);
         }
     }
 
@@ -165,6 +201,28 @@ pub fn point_clearance(p: &P2, region: &Region) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use std::f64::consts::TAU;
+
+    #[test]
+    fn an_entry_descends_no_steeper_than_its_ramp_then_loops_once_at_depth() {
+        // 10 mm at 5° along a 15.708 mm loop (radius 2.5): 114.3 mm of ramp, 7.28 loops, so 8
+        // descending (at 4.55°) and one at depth; none descends without a depth.
+        let e = Entry { drop: 10.0, ramp_deg: 5.0 };
+        let l = TAU * 2.5;
+        assert_eq!(e.loops(l), 9);
+        let grade = e.drop / ((e.loops(l) - 1) as f64 * l);
+        assert!(grade <= 5f64.to_radians().tan() && grade > 4.5f64.to_radians().tan(), "{grade}");
+        // A whole number of loops at the ramp exactly: no extra loop for the roundoff.
+        let exact = Entry { drop: 3.0 * l * 5f64.to_radians().tan(), ramp_deg: 5.0 };
+        assert_eq!(exact.loops(l), 4);
+        assert_eq!(Entry::FLAT.loops(l), 1);
+        // Each loop pushed whole, the first after a retract.
+        let mut p = Program::default();
+        p.push_entry(&Contour::circle(P2::new(0.0, 0.0), 2.5, 0.0, true), &e);
+        assert!((p.length(Tag::Entry) - 9.0 * l).abs() < 1e-9);
+        assert_eq!(p.moves.iter().filter(|m| m.retract_before).count(), 1);
+        assert!(p.moves[0].retract_before);
+    }
 
     #[test]
     fn a_link_that_no_longer_starts_where_its_pass_ends_is_made_again_or_retracted() {

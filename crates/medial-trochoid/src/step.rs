@@ -51,6 +51,7 @@ mod tests {
             sample: 0.5,
             medial: MedialOptions::default(),
             feed: FeedModel { spindle: 4800.0, teeth: 6.0, chip: 0.03, fz_max: 0.1, force_at: Some(40.0) },
+            entry: crate::program::Entry::FLAT,
         };
         let phi = 40f64.to_radians();
         let square =

@@ -3,21 +3,22 @@
 //! started on the right of travel so that the step to the next loop leaves it tangentially.
 
 use crate::engagement::Cut;
-use crate::program::{Move, Program, Tag};
+use crate::program::{Entry, Move, Program, Tag};
 use camkit::contour::{Contour, Seg};
 use camkit::geom::{P2, V2};
 
-/// Appends trochoids along `run` with loop radius `rt` and `pitch` to `prog`.
+/// Appends trochoids along `run` with loop radius `rt` and `pitch` to `prog` (the entry loop
+/// flat: for the engagement of the loops).
 pub fn push_trochoids(prog: &mut Program, run: &[P2], rt: f64, pitch: f64) {
     let centres: Vec<(P2, f64)> = resample(run, pitch).into_iter().map(|c| (c, rt)).collect();
-    push_loops(prog, &centres);
+    push_loops(prog, &centres, &Entry::FLAT);
 }
 
 /// Appends trochoids along `run` whose loop radius and pitch at point `i` of the run are
 /// `radii[i]` and `pitches[i]`, radii not increasing along the run (a smaller loop after a
 /// larger one meets no more material than the pitch allows). Each step is the pitch at the
 /// far end of the step (the smaller), each loop the radius there.
-pub fn push_varying(prog: &mut Program, run: &[P2], radii: &[f64], pitches: &[f64]) {
+pub fn push_varying(prog: &mut Program, run: &[P2], radii: &[f64], pitches: &[f64], entry: &Entry) {
     let Some(&first) = run.first() else { return };
     let mut cum = vec![0.0];
     for w in run.windows(2) {
@@ -39,12 +40,13 @@ pub fn push_varying(prog: &mut Program, run: &[P2], radii: &[f64], pitches: &[f6
         s = (s + p).min(total);
         centres.push((point(s), radii[at(s)]));
     }
-    push_loops(prog, &centres);
+    push_loops(prog, &centres, entry);
 }
 
 /// Appends one loop per centre (with its radius): a helical entry circle at the first, then one
-/// counter-clockwise (climb) circle per centre, each started on the right of travel.
-fn push_loops(prog: &mut Program, centres: &[(P2, f64)]) {
+/// counter-clockwise (climb) circle per centre, each started on the right of travel; the entry
+/// circle cut as `entry` takes it down.
+fn push_loops(prog: &mut Program, centres: &[(P2, f64)], entry: &Entry) {
     let pts: Vec<P2> = centres.iter().map(|c| c.0).collect();
     let mut previous: Option<P2> = None;
     for (k, &(c, rt)) in centres.iter().enumerate() {
@@ -56,8 +58,11 @@ fn push_loops(prog: &mut Program, centres: &[(P2, f64)]) {
         }
         let start = (s - c).y.atan2((s - c).x);
         let circle = Contour::circle(c, rt, start, true);
-        let tag = if k == 0 { Tag::Entry } else { Tag::Trochoid };
-        prog.push_contour(&circle, tag, k == 0);
+        if k == 0 {
+            prog.push_entry(&circle, entry);
+        } else {
+            prog.push_contour(&circle, Tag::Trochoid, false);
+        }
         previous = Some(s);
     }
 }
@@ -152,7 +157,7 @@ mod tests {
         let radii: Vec<f64> = (0..=20).map(|k| 2.0 - 0.05 * f64::from(k)).collect();
         let pitches: Vec<f64> = radii.iter().map(|r| 0.1 * r).collect();
         let mut prog = Program::default();
-        push_varying(&mut prog, &run, &radii, &pitches);
+        push_varying(&mut prog, &run, &radii, &pitches, &Entry::FLAT);
         // Loop centres (arc centres), in order: steps never longer than the pitch at their far end.
         let mut centres: Vec<(P2, f64)> = Vec::new();
         for m in &prog.moves {
