@@ -44,7 +44,15 @@ done
 # the plan's own time in plan_seconds) at each target of ADAPTIVE_TARGETS (default "40 freecad":
 # 40° and FreeCAD's largest engagement on that pocket rounded down to the degree) and analysed
 # by the same referee; all at the same feed model (force limit of the 40° side cut, --force-at 40).
+# Each pocket is 10 mm deep under FreeCAD's --top, which FreeCAD enters by a 5° helix: ours is
+# planned as one 10 mm layer at the same default 5° (--layers 1 --layer-depth 10), so both pay
+# their entry. REFEREE (default 1) is the referee's sample step in mm: 0.25 finds what falls
+# between a program's 1 mm samples (the 1 mm referee also times each stretch at its slower end's
+# feed, 3-5 % pessimistic on these programs).
 TARGETS=${ADAPTIVE_TARGETS:-40 freecad}
+REFEREE=${REFEREE:-1}
+DEPTH=(--layers 1 --layer-depth 10)
+TOOL=(--radius 5 --trochoid-radius 2.5)
 echo "pocket | FreeCAD: largest, length, min (feed following / one feed per kind), Execute s | ours adaptive: largest, length (links), min (feed following / one feed per kind), plan s | ratios"
 for spec in "box-die 0 0 100 100 60" "islands2 0 0 100 60 10" "dumbbell 0 0 94 40 10" "circle40 10 10 90 90 10"; do
   set -- $spec
@@ -52,12 +60,12 @@ for spec in "box-die 0 0 100 100 60" "islands2 0 0 100 60 10" "dumbbell 0 0 94 4
   SRCP=data/medial-trochoid/$P.csv
   fcout=$(python3 scripts/freecad-adaptive.py "$SRCP" "$tmp/fc-$P.csv" --diameter 10 --stepover 11.82 --stock "$2" "$3" "$4" "$5" --top "$6")
   fcsec=$(echo "$fcout" | sed -n 's/.*seconds \([0-9.]*\).*/\1/p')
-  "$B" "$SRCP" "${COMMON[@]}" --threshold 40 --force-at 40 --analyse "$tmp/fc-$P.csv" --report "$tmp/fc-$P.json" -o "$tmp/fca-$P.csv"
+  "$B" "$SRCP" "${TOOL[@]}" --sample "$REFEREE" --threshold 40 --force-at 40 --analyse "$tmp/fc-$P.csv" --report "$tmp/fc-$P.json" -o "$tmp/fca-$P.csv"
   for TARGET_DEG in $TARGETS; do
   # "freecad": FreeCAD's measured largest engagement rounded down to the degree (the issue's bound).
   [ "$TARGET_DEG" = freecad ] && TARGET_DEG=$(python3 -c "import json,sys,math; print(math.floor(json.load(open(sys.argv[1]))['largest_engagement_deg']))" "$tmp/fc-$P.json")
-  RAYON_NUM_THREADS=1 "$B" "$SRCP" "${COMMON[@]}" --strategy adaptive --threshold "$TARGET_DEG" --force-at 40 --report "$tmp/ad-$P.json" -o "$tmp/ad-$P.csv" 2>/dev/null
-  "$B" "$SRCP" "${COMMON[@]}" --threshold "$TARGET_DEG" --force-at 40 --analyse "$tmp/ad-$P.csv" --report "$tmp/ada-$P.json" -o "$tmp/adaa-$P.csv"
+  RAYON_NUM_THREADS=1 "$B" "$SRCP" "${COMMON[@]}" "${DEPTH[@]}" --strategy adaptive --threshold "$TARGET_DEG" --force-at 40 --report "$tmp/ad-$P.json" -o "$tmp/ad-$P.csv" 2>/dev/null
+  "$B" "$SRCP" "${TOOL[@]}" --sample "$REFEREE" --threshold "$TARGET_DEG" --force-at 40 --analyse "$tmp/ad-$P.csv" --report "$tmp/ada-$P.json" -o "$tmp/adaa-$P.csv"
   python3 - "$P@$TARGET_DEG°" "$fcsec" "$tmp/fc-$P.json" "$tmp/ad-$P.json" "$tmp/ada-$P.json" <<'PY'
 import json, sys
 p, fcsec = sys.argv[1], float(sys.argv[2])

@@ -95,6 +95,12 @@ const ROOT_TOL: f64 = 0.003;
 /// Root-finding rounds on a step's heading.
 const BISECTIONS: usize = 8;
 
+/// Fractions along a step, besides its end, where its engagement must hold the target: the
+/// engagement is not monotone along a step (the tool circle sweeps over envelope arcs of its
+/// own radius), and a 0.25 mm re-simulation of box-die found 80° between the end and middle
+/// of a 67° step when only those two were held.
+const HELD_AT: [f64; 3] = [0.5, 0.25, 0.75];
+
 /// The cut so far, indexed piece by piece.
 struct Cutting {
     cut: Cut,
@@ -470,8 +476,28 @@ fn walk_pass(
 
 /// The heading between `left` (least engagement) and `right` (most) that turns furthest right
 /// while the step keeps the wall distance and its end's engagement holds the target, with that
-/// engagement (radians); `None` if even `left` does not.
+/// engagement (radians); `None` if even `left` does not. The heading is searched holding the
+/// end and middle, then checked at [`HELD_AT`]'s quarters, and searched again holding those
+/// too where they do not hold (rarely: a third of the search's cost saved).
 fn choose(cutting: &Cutting, region: &Region, w: &Walk, p: P2, left: f64, right: f64) -> Option<(f64, f64)> {
+    let (theta, e) = choose_holding(cutting, region, w, p, left, right, &HELD_AT[..1])?;
+    let seg = Seg::Line(p, w.snap(p + V2::new(theta.cos(), theta.sin()) * w.step));
+    if HELD_AT[1..].iter().all(|&t| cutting.cut.engagement_after(&[seg], 0, t) <= w.target) {
+        return Some((theta, e));
+    }
+    choose_holding(cutting, region, w, p, left, right, &HELD_AT)
+}
+
+/// [`choose`] with the engagement held at the step's end and at the fractions `held` of it.
+fn choose_holding(
+    cutting: &Cutting,
+    region: &Region,
+    w: &Walk,
+    p: P2,
+    left: f64,
+    right: f64,
+    held: &[f64],
+) -> Option<(f64, f64)> {
     let step = |theta: f64| Seg::Line(p, w.snap(p + V2::new(theta.cos(), theta.sin()) * w.step));
     // The end's engagement less the target (radians); a step that breaks the wall distance
     // counts as a full turn over.
@@ -482,8 +508,11 @@ fn choose(cutting: &Cutting, region: &Region, w: &Walk, p: P2, left: f64, right:
         }
         cutting.cut.engagement_after(&[seg], 0, 1.0) - w.target
     };
-    // The step holds the target at its end and half way (the whole-program check samples both).
-    let holds = |theta: f64, f: f64| f <= 0.0 && cutting.cut.engagement_after(&[step(theta)], 0, 0.5) <= w.target;
+    // The step holds the target at its end and at `held` (the whole-program check samples the
+    // end and middle).
+    let holds = |theta: f64, f: f64| {
+        f <= 0.0 && held.iter().all(|&t| cutting.cut.engagement_after(&[step(theta)], 0, t) <= w.target)
+    };
     let fr = over(right);
     if holds(right, fr) {
         return Some((right, fr + w.target));
@@ -649,5 +678,19 @@ mod tests {
         assert!(plan.program.moves.iter().filter(|m| m.tag == Tag::Contour).all(|m| m.seg.length() <= s.sample + 1e-9));
         // What is left is named and smaller than the pocket.
         assert!(plan.uncut_area < 0.05 * (40.0 * 20.0 + 20.0 * 20.0), "{}", plan.uncut_area);
+    }
+
+    #[test]
+    fn the_target_holds_between_the_samples_the_plan_checks() {
+        // Re-simulated every quarter step (the planner holds ends, middles and quarters), at
+        // targets where a check of ends and middles alone lets a step run over between them.
+        let regions = l_pocket();
+        for target in [40.0, 55.0, 67.0] {
+            let s = Settings { threshold: target, ..Settings::for_tests(3.0) };
+            let plan = plan_adaptive(&regions, &s, None).expect("a plan");
+            let fine = Settings { sample: s.sample / 4.0, ..s };
+            let a = crate::analyse(plan.program.clone(), &fine, &regions);
+            assert!(a.max_cutting <= target + crate::ENGAGEMENT_ROUNDOFF_DEG, "{target}: {}", a.max_cutting);
+        }
     }
 }
