@@ -25,7 +25,9 @@ on trochoid and contour rows; every straight move (from the row before) R + allo
 more from the walls along its whole length (links across the pocket included); every uncut
 stretch's from/to on the loop it names (1e-6 mm) and 0 <= uncut_area_mm2 < the pocket's area; and
 `--analyse` of the written program gives the report's figures of it exactly (engagement of cuts,
-links and entries, samples over the threshold, clearance, no_gouge, threshold_held).
+links and entries, samples over the threshold, clearance, no_gouge, threshold_held); with
+--strategy adaptive also `--analyse --sample 0.125` (a quarter of the default step) finds nothing
+over the threshold.
 """
 import csv, json, math, os, random, re, shutil, subprocess, sys, tempfile, time
 from concurrent.futures import ThreadPoolExecutor
@@ -34,6 +36,8 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from fuzzkit import arc_centre, binary, inside, seg_dist  # noqa: E402
 
 BIN = os.environ.get("TROCHOID", binary("medial-trochoid"))
+# The finer referee's sample step for --strategy adaptive (mm): a quarter of the default 0.5.
+FINE_SAMPLE = 0.125
 CLEAR_TOL, ENG_TOL, ON_LOOP_TOL = 1e-6, 1e-5, 1e-6
 STRATEGY = sys.argv[sys.argv.index("--strategy") + 1] if "--strategy" in sys.argv else None
 THRESHOLDS = [float(t) for t in sys.argv[sys.argv.index("--thresholds") + 1].split(",")] if "--thresholds" in sys.argv else [40, 30]
@@ -359,6 +363,20 @@ def agree(binary, src, run, out, rep, stats):
     stats["link_deg"] = max(stats["link_deg"], given["link_engagement_deg"])
     stats["largest_deg"] = max(stats["largest_deg"], given["largest_engagement_deg"])
     fails = [f"--analyse {k} {given.get(k)} vs the report's {rep.get(k)}" for k in AGREE if given.get(k) != rep.get(k)]
+    if STRATEGY == "adaptive":
+        # The planner holds each step's end, middle and quarters: a referee sampling every
+        # quarter of the default 0.5 mm step finds nothing over the threshold either.
+        p = subprocess.run([binary, src, "--radius", str(R), "--threshold", str(thr), "--allowance", str(allow),
+                            "--sample", str(FINE_SAMPLE), "--analyse", out, "--report", an, "-o", os.devnull],
+                           capture_output=True, text=True)
+        if p.returncode != 0:
+            return fails + [f"--analyse --sample {FINE_SAMPLE} exit {p.returncode}: {p.stderr.strip()[-200:]}"]
+        with open(an) as fh:
+            fine = json.load(fh)["largest_engagement_deg"]
+        os.remove(an)
+        stats["fine_over"] = max(stats["fine_over"], fine - thr)
+        if fine > thr + ENG_TOL:
+            fails.append(f"--analyse --sample {FINE_SAMPLE}: largest engagement {fine} over {thr}")
     stats["agreed"] += not fails
     return fails
 
@@ -397,7 +415,8 @@ def main():
     fams = list(FAMILIES) if fam == "all" else [fam]
     radii = tuple(float(r) if "." in r else int(r) for r in opt("--radii", "2,3,5").split(","))
     counts, kept = {"exit0": 0, "exit2": 0, "defect": 0}, []
-    stats = {"shortfall": -1e9, "on_loop": 0.0, "uncut_runs": 0, "analysed": 0, "agreed": 0, "link_deg": 0.0, "largest_deg": 0.0}
+    stats = {"shortfall": -1e9, "on_loop": 0.0, "uncut_runs": 0, "analysed": 0, "agreed": 0, "link_deg": 0.0, "largest_deg": 0.0,
+             "fine_over": -1e9}
     per_family = {f: [0, 0, 0] for f in fams}
     causes = {"exit 1, --step side-cuts over the threshold": 0, "exit 1, other": 0, "other": 0}
     os.makedirs(keep, exist_ok=True)
@@ -472,6 +491,8 @@ def main():
     print(f"--analyse of {stats['agreed']} of {stats['analysed']} written programs (those that passed the checks above)"
           f" agreed with their reports on {', '.join(AGREE)};"
           f" largest engagement analysed {stats['largest_deg']:.6f} deg, on links {stats['link_deg']:.6f} deg")
+    if STRATEGY == "adaptive":
+        print(f"largest engagement over the threshold at the {FINE_SAMPLE} mm referee: {stats['fine_over']:.3g} deg")
     sys.exit(1 if kept else 0)
 
 
